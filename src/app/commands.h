@@ -1,0 +1,27 @@
+#pragma once
+
+#include <functional>
+
+#include <CLI/CLI.hpp>
+
+namespace ecv::app {
+
+/// Exit codes of every subcommand (DESIGN.md, "Errors").
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitBadInput = 1;
+inline constexpr int kExitBadUsage = 2;
+
+/// What a subcommand does once its flags are parsed; returns the exit code.
+using CommandAction = std::function<int()>;
+
+/// One row of the subcommand table: its name, a one-line summary, and a function that declares its
+/// flags on `command` and returns its action.
+struct Subcommand {
+  const char* name;
+  const char* summary;
+  CommandAction (*setup)(CLI::App& command);
+};
+
+CommandAction SetupInfoCommand(CLI::App& command);
+
+}  // namespace ecv::app

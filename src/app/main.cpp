@@ -1,0 +1,59 @@
+// ecvpose: one command-line tool, a table of subcommands. Each reads its flags into options and calls
+// one library function; only this file turns exceptions into exit codes.
+
+#include <iostream>
+#include <utility>
+#include <vector>
+
+#include "app/commands.h"
+#include "core/error.h"
+#include "core/version.h"
+
+namespace {
+
+using ecv::app::Subcommand;
+
+const Subcommand kSubcommands[] = {
+    {"info", "Describe RGB-D frames (size, camera, depth) and meshes (size, colouring, diameter)",
+     ecv::app::SetupInfoCommand},
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "ecvpose: find known objects, with their 6D pose, in RGB-D images.\n"
+      "Give a subcommand; `ecvpose <subcommand> --help` describes each.",
+      "ecvpose"};
+  app.set_version_flag("--version", std::string("ecvpose ") + ecv::kVersion);
+  app.require_subcommand(1);
+  std::vector<std::pair<CLI::App*, ecv::app::CommandAction>> actions;
+  for (const Subcommand& subcommand : kSubcommands) {
+    CLI::App* command = app.add_subcommand(subcommand.name, subcommand.summary);
+    actions.emplace_back(command, subcommand.setup(*command));
+  }
+
+  if (argc <= 1) {
+    std::cout << app.help();
+    return ecv::app::kExitBadUsage;
+  }
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& error) {
+    const int code = app.exit(error);  // prints help, the version, or the usage error
+    return code == 0 ? ecv::app::kExitOk : ecv::app::kExitBadUsage;
+  }
+
+  try {
+    for (auto& [command, action] : actions) {
+      if (command->parsed()) return action();
+    }
+  } catch (const ecv::InputError& error) {
+    std::cerr << "ecvpose: error: " << error.what() << '\n';
+    return ecv::app::kExitBadInput;
+  } catch (const std::exception& error) {
+    std::cerr << "ecvpose: error: " << error.what() << '\n';
+    return ecv::app::kExitBadInput;
+  }
+  return ecv::app::kExitBadUsage;
+}

@@ -1,0 +1,62 @@
+#include "core/frame.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "core/error.h"
+
+namespace ecv {
+namespace {
+
+std::string SizeText(const cv::Mat& image) {
+  return std::to_string(image.cols) + "x" + std::to_string(image.rows);
+}
+
+}  // namespace
+
+void RgbdFrame::Check() const {
+  if (color.empty() || color.type() != CV_8UC3) ThrowInputError(name, "color", "an 8-bit 3-channel RGB image");
+  if (depth.empty() || depth.type() != CV_32FC1) ThrowInputError(name, "depth", "a float depth image in metres");
+  if (color.size() != depth.size()) {
+    ThrowInputError(name, "depth", "the colour image's size " + SizeText(color), SizeText(depth));
+  }
+  camera.Check(name + ": camera");
+  if (camera.width != color.cols || camera.height != color.rows) {
+    ThrowInputError(name, "camera", "the image size " + SizeText(color),
+                    std::to_string(camera.width) + "x" + std::to_string(camera.height));
+  }
+  for (int v = 0; v < depth.rows; ++v) {
+    const float* row = depth.ptr<float>(v);
+    for (int u = 0; u < depth.cols; ++u) {
+      if (!(row[u] >= 0.0F) || !std::isfinite(row[u])) {
+        ThrowInputError(name, "depth", "finite values >= 0 (0 = missing)",
+                        std::to_string(row[u]) + " at pixel (" + std::to_string(u) + ", " + std::to_string(v) + ")");
+      }
+    }
+  }
+}
+
+DepthStats ComputeDepthStats(const cv::Mat& depth, const cv::Mat& mask) {
+  CV_Assert(depth.type() == CV_32FC1 && (mask.empty() || mask.size() == depth.size()));
+  std::vector<float> valid;
+  valid.reserve(depth.total());
+  for (int v = 0; v < depth.rows; ++v) {
+    const float* row = depth.ptr<float>(v);
+    const uchar* mask_row = mask.empty() ? nullptr : mask.ptr<uchar>(v);
+    for (int u = 0; u < depth.cols; ++u) {
+      if (row[u] > 0.0F && (mask_row == nullptr || mask_row[u] != 0)) valid.push_back(row[u]);
+    }
+  }
+  DepthStats stats;
+  if (valid.empty()) return stats;
+  stats.valid_fraction = static_cast<double>(valid.size()) / static_cast<double>(depth.total());
+  const auto [min_it, max_it] = std::minmax_element(valid.begin(), valid.end());
+  stats.min_m = *min_it;
+  stats.max_m = *max_it;
+  std::nth_element(valid.begin(), valid.begin() + static_cast<long>(valid.size() / 2), valid.end());
+  stats.median_m = valid[valid.size() / 2];
+  return stats;
+}
+
+}  // namespace ecv

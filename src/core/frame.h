@@ -1,0 +1,34 @@
+#pragma once
+
+#include <string>
+
+#include <opencv2/core.hpp>
+
+#include "core/camera.h"
+
+namespace ecv {
+
+/// One registered RGB-D image.
+struct RgbdFrame {
+  cv::Mat color;         ///< CV_8UC3, RGB order, top row first
+  cv::Mat depth;         ///< CV_32FC1, metres along the optical axis, 0 = missing; same size as color
+  PinholeCamera camera;  ///< intrinsics of both images
+  std::string name;      ///< where it came from, for messages
+
+  /// Throws InputError naming `name` when the images are empty, of the wrong type or of a size that
+  /// differs from each other or from the camera, or when the depth holds negative or NaN values.
+  void Check() const;
+};
+
+/// Summary of a depth image.
+struct DepthStats {
+  double valid_fraction = 0.0;  ///< pixels with depth > 0, over all pixels
+  double min_m = 0.0;           ///< smallest valid depth, metres (0 if none)
+  double max_m = 0.0;           ///< largest valid depth, metres (0 if none)
+  double median_m = 0.0;        ///< median valid depth, metres (0 if none)
+};
+
+/// Statistics over the valid (> 0) pixels of a CV_32FC1 depth image, optionally only where `mask` != 0.
+DepthStats ComputeDepthStats(const cv::Mat& depth, const cv::Mat& mask = cv::Mat());
+
+}  // namespace ecv

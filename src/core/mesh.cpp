@@ -1,0 +1,93 @@
+#include "core/mesh.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace ecv {
+
+const char* ToString(MeshColoring coloring) {
+  switch (coloring) {
+    case MeshColoring::kTexture: return "texture";
+    case MeshColoring::kVertexColor: return "vertex colour";
+    case MeshColoring::kMaterialColor: return "material colour";
+  }
+  return "unknown";
+}
+
+size_t TriangleMesh::NumVertices() const {
+  size_t count = 0;
+  for (const MeshPart& part : parts) count += part.positions.size();
+  return count;
+}
+
+size_t TriangleMesh::NumTriangles() const {
+  size_t count = 0;
+  for (const MeshPart& part : parts) count += part.triangles.size();
+  return count;
+}
+
+MeshColoring TriangleMesh::Coloring(const MeshPart& part) const {
+  const bool has_texture = part.material >= 0 && part.material < static_cast<int>(materials.size()) &&
+                           !materials[static_cast<size_t>(part.material)].texture.empty();
+  if (has_texture && !part.texcoords.empty()) return MeshColoring::kTexture;
+  if (!part.colors.empty()) return MeshColoring::kVertexColor;
+  return MeshColoring::kMaterialColor;
+}
+
+Eigen::AlignedBox3d TriangleMesh::BoundingBox() const {
+  Eigen::AlignedBox3d box;
+  for (const MeshPart& part : parts) {
+    for (const Eigen::Vector3f& p : part.positions) box.extend(p.cast<double>());
+  }
+  return box;
+}
+
+double TriangleMesh::Diameter() const {
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(NumVertices());
+  for (const MeshPart& part : parts) {
+    for (const Eigen::Vector3f& p : part.positions) points.push_back(p.cast<double>());
+  }
+  if (points.size() < 2) return 0.0;
+
+  // Exact search with pruning: |p_i - p_j| <= r_i + r_j with r the distance to the box centre, so with
+  // points sorted by r (largest first) both loops stop once r_i + r_j cannot beat the best pair.
+  const Eigen::Vector3d centre = BoundingBox().center();
+  std::vector<double> radius(points.size());
+  for (size_t i = 0; i < points.size(); ++i) radius[i] = (points[i] - centre).norm();
+  std::vector<size_t> order(points.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return radius[a] > radius[b]; });
+
+  double best_squared = 0.0;
+  for (size_t a = 0; a < order.size(); ++a) {
+    const size_t i = order[a];
+    const double bound = radius[i] + radius[order[0]];
+    if (bound * bound <= best_squared) break;
+    for (size_t b = a + 1; b < order.size(); ++b) {
+      const size_t j = order[b];
+      const double pair_bound = radius[i] + radius[j];
+      if (pair_bound * pair_bound <= best_squared) break;
+      best_squared = std::max(best_squared, (points[i] - points[j]).squaredNorm());
+    }
+  }
+  return std::sqrt(best_squared);
+}
+
+void TriangleMesh::Transform(const Eigen::Isometry3d& new_from_old) {
+  const Eigen::Matrix3f rotation = new_from_old.linear().cast<float>();
+  const Eigen::Vector3f translation = new_from_old.translation().cast<float>();
+  for (MeshPart& part : parts) {
+    for (Eigen::Vector3f& p : part.positions) p = rotation * p + translation;
+    for (Eigen::Vector3f& n : part.normals) n = rotation * n;
+  }
+}
+
+void TriangleMesh::Scale(double factor) {
+  for (MeshPart& part : parts) {
+    for (Eigen::Vector3f& p : part.positions) p *= static_cast<float>(factor);
+  }
+}
+
+}  // namespace ecv

@@ -1,0 +1,61 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
+namespace ecv {
+
+/// How a mesh part gets its colour when rendered.
+enum class MeshColoring { kTexture, kVertexColor, kMaterialColor };
+
+/// Name for messages: "texture", "vertex colour", "material colour".
+const char* ToString(MeshColoring coloring);
+
+/// Surface appearance shared by mesh parts.
+struct MeshMaterial {
+  std::string name;
+  Eigen::Vector3f diffuse_color{0.8F, 0.8F, 0.8F};  ///< RGB in [0, 1], used where there is no texture
+  cv::Mat texture;                                  ///< CV_8UC3 RGB as stored (row 0 = v = 1); empty if none
+  std::string texture_path;                         ///< resolved file, "" if none, "*N" if embedded
+};
+
+/// Triangles of one material. Vertex attributes are parallel arrays; optional ones are empty.
+struct MeshPart {
+  std::vector<Eigen::Vector3f> positions;  ///< object frame, metres
+  std::vector<Eigen::Vector3f> normals;    ///< unit, object frame; empty if none
+  std::vector<Eigen::Vector2f> texcoords;  ///< (u, v), OBJ convention: texture row = (1 - v) * height
+  std::vector<Eigen::Vector3f> colors;     ///< per-vertex RGB in [0, 1]; empty if none
+  std::vector<Eigen::Vector3i> triangles;  ///< indices into the vertex arrays
+  int material = -1;                       ///< index into TriangleMesh::materials, -1 for none
+};
+
+/// A triangle mesh in the object frame (metres), as loaded by io/mesh_io.h.
+struct TriangleMesh {
+  std::string name;  ///< file stem unless given
+  std::vector<MeshPart> parts;
+  std::vector<MeshMaterial> materials;
+
+  size_t NumVertices() const;
+  size_t NumTriangles() const;
+
+  /// Colouring of one part: texture if its material has an image and the part has texcoords, else
+  /// vertex colours if present, else the material colour.
+  MeshColoring Coloring(const MeshPart& part) const;
+
+  /// Axis-aligned box of all vertices, metres; empty box for an empty mesh.
+  Eigen::AlignedBox3d BoundingBox() const;
+
+  /// Largest distance between two vertices, metres (exact; as BOP's models_info "diameter").
+  double Diameter() const;
+
+  /// Maps every position and normal by `new_from_old` (x_new = R x_old + t).
+  void Transform(const Eigen::Isometry3d& new_from_old);
+
+  /// Multiplies every position by `factor` (a unit change).
+  void Scale(double factor);
+};
+
+}  // namespace ecv

@@ -1,0 +1,186 @@
+#include "io/frame_io.h"
+
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/error.h"
+#include "io/pose_io.h"
+
+namespace ecv {
+namespace fs = std::filesystem;
+namespace {
+
+constexpr const char* kFrameForms =
+    "a frame JSON, a YCB-Video prefix (.../0001/000001 with -color.png beside it), a BOP image "
+    "SCENE_DIR:IMAGE_ID or an organized .pcd";
+
+void RequireFile(const std::string& path, const std::string& what) {
+  if (!fs::exists(path)) ThrowInputError(path, what, "an existing file", "no such file");
+  if (fs::is_directory(path)) ThrowInputError(path, what, "a file", "a directory");
+}
+
+std::string ImageTypeText(const cv::Mat& image) {
+  const int depth = image.depth();
+  const char* bits = depth == CV_8U ? "8-bit" : depth == CV_16U ? "16-bit" : depth == CV_32F ? "32-bit float" : "other";
+  return std::string(bits) + " " + std::to_string(image.channels()) + "-channel";
+}
+
+bool EndsWith(const std::string& text, const std::string& suffix) {
+  return text.size() >= suffix.size() && text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+// "SCENE_DIR:IMAGE_ID" with an existing directory and a decimal id.
+bool SplitBopImage(const std::string& text, std::string* scene_dir, int* image_id) {
+  const size_t colon = text.rfind(':');
+  if (colon == std::string::npos || colon + 1 >= text.size()) return false;
+  const std::string id = text.substr(colon + 1);
+  if (id.find_first_not_of("0123456789") != std::string::npos || id.size() > 9) return false;
+  *scene_dir = text.substr(0, colon);
+  *image_id = std::stoi(id);
+  return fs::is_directory(*scene_dir);
+}
+
+bool HasFlagForm(const FrameSpec& spec) {
+  return !spec.color_path.empty() || !spec.depth_path.empty() || spec.depth_scale || spec.camera;
+}
+
+LoadedFrame LoadPositional(const FrameSpec& spec) {
+  const std::string& path = spec.positional;
+  std::string scene_dir;
+  int image_id = 0;
+  if (SplitBopImage(path, &scene_dir, &image_id)) {
+    if (!spec.color_path.empty() || spec.camera) {
+      ThrowInputError(path, "--color/--camera", "no --color or --camera with a BOP image (only --depth)");
+    }
+    LoadedFrame loaded = LoadBopFrame(scene_dir, image_id, spec.depth_path);
+    if (spec.depth_scale) {
+      const std::string depth = spec.depth_path.empty() ? path : spec.depth_path;
+      loaded.rgbd.depth = ReadDepthImage(depth, *spec.depth_scale);
+    }
+    loaded.rgbd.Check();
+    return loaded;
+  }
+  if (HasFlagForm(spec)) {
+    ThrowInputError(path, "FRAME", "either a positional FRAME or --color/--depth/--depth-scale/--camera, not both");
+  }
+  if (EndsWith(path, ".json")) return LoadFrameJson(path);
+  if (EndsWith(path, ".pcd")) return LoadPcdFrame(path);
+  if (fs::exists(path + "-color.png")) return LoadYcbvFrame(path);
+  if (fs::exists(path)) ThrowInputError(path, "FRAME", kFrameForms, "a file of none of these forms");
+  ThrowInputError(path, "FRAME", kFrameForms, "no such file, YCB-Video prefix or BOP scene directory");
+}
+
+}  // namespace
+
+LoadedFrame LoadFrame(const FrameSpec& spec) {
+  if (!spec.positional.empty()) return LoadPositional(spec);
+  if (spec.color_path.empty() || spec.depth_path.empty() || !spec.depth_scale || !spec.camera) {
+    ThrowInputError("frame", "--color/--depth/--depth-scale/--camera",
+                    std::string("all four flags, or one positional FRAME: ") + kFrameForms);
+  }
+  LoadedFrame loaded;
+  loaded.rgbd = MakeFrame(spec.color_path, spec.depth_path, *spec.depth_scale,
+                          ParseIntrinsics(*spec.camera, "--camera"), spec.color_path);
+  return loaded;
+}
+
+cv::Mat ReadColorImage(const std::string& path) {
+  RequireFile(path, "colour image");
+  const cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
+  if (image.empty()) ThrowInputError(path, "colour image", "a PNG or JPG image", "an unreadable file");
+  if (image.depth() != CV_8U || (image.channels() != 3 && image.channels() != 4 && image.channels() != 1)) {
+    ThrowInputError(path, "colour image", "an 8-bit grey, RGB or RGBA image", ImageTypeText(image));
+  }
+  cv::Mat rgb;
+  const int code = image.channels() == 1   ? cv::COLOR_GRAY2RGB
+                   : image.channels() == 4 ? cv::COLOR_BGRA2RGB
+                                           : cv::COLOR_BGR2RGB;
+  cv::cvtColor(image, rgb, code);
+  return rgb;
+}
+
+cv::Mat ReadDepthImage(const std::string& path, double depth_scale) {
+  if (!std::isfinite(depth_scale) || depth_scale <= 0.0) {
+    ThrowInputError(path, "depth_scale", "a finite positive scale (metres = value / scale)",
+                    std::to_string(depth_scale));
+  }
+  RequireFile(path, "depth image");
+  const cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
+  if (image.empty()) ThrowInputError(path, "depth image", "a 16-bit single-channel PNG", "an unreadable file");
+  if (image.type() != CV_16UC1) {
+    ThrowInputError(path, "depth image", "a 16-bit single-channel PNG", ImageTypeText(image));
+  }
+  cv::Mat metres;
+  image.convertTo(metres, CV_32F, 1.0 / depth_scale);
+  return metres;
+}
+
+std::array<double, 4> ParseIntrinsics(const std::string& text, const std::string& source) {
+  std::vector<double> values;
+  std::stringstream stream(text);
+  std::string item;
+  while (std::getline(stream, item, ',')) {
+    size_t used = 0;
+    double value = 0.0;
+    try {
+      value = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || item.find_first_not_of(" \t", used) != std::string::npos) {
+      ThrowInputError(source, "camera", "four numbers fx,fy,cx,cy in pixels", "'" + text + "'");
+    }
+    values.push_back(value);
+  }
+  if (values.size() != 4) ThrowInputError(source, "camera", "four numbers fx,fy,cx,cy in pixels", "'" + text + "'");
+  return {values[0], values[1], values[2], values[3]};
+}
+
+RgbdFrame MakeFrame(const std::string& color_path, const std::string& depth_path, double depth_scale,
+                    const std::array<double, 4>& intrinsics, const std::string& source) {
+  RgbdFrame frame;
+  frame.name = source;
+  frame.color = ReadColorImage(color_path);
+  frame.depth = ReadDepthImage(depth_path, depth_scale);
+  if (frame.color.size() != frame.depth.size()) {
+    ThrowInputError(depth_path, "depth image size",
+                    std::to_string(frame.color.cols) + "x" + std::to_string(frame.color.rows) +
+                        " as the colour image " + color_path,
+                    std::to_string(frame.depth.cols) + "x" + std::to_string(frame.depth.rows));
+  }
+  frame.camera = {intrinsics[0], intrinsics[1], intrinsics[2], intrinsics[3], frame.color.cols, frame.color.rows};
+  frame.Check();
+  return frame;
+}
+
+LoadedFrame LoadFrameJson(const std::string& path) {
+  const nlohmann::json json = ReadJsonFile(path);
+  const fs::path base = fs::path(path).parent_path();
+  auto string_field = [&](const char* key) {
+    if (!json.contains(key) || !json[key].is_string())
+      ThrowInputError(path, key, "a string (a path relative to the JSON)");
+    return (base / json[key].get<std::string>()).string();
+  };
+  if (!json.contains("depth_scale") || !json["depth_scale"].is_number()) {
+    ThrowInputError(path, "depth_scale", "a number S (metres = depth value / S)");
+  }
+  if (!json.contains("camera") || !json["camera"].is_array() || json["camera"].size() != 4) {
+    ThrowInputError(path, "camera", "an array [fx, fy, cx, cy] of 4 numbers in pixels");
+  }
+  std::array<double, 4> intrinsics{};
+  for (size_t i = 0; i < 4; ++i) {
+    const nlohmann::json& value = json["camera"][i];
+    if (!value.is_number()) ThrowInputError(path, "camera", "an array [fx, fy, cx, cy] of 4 numbers in pixels");
+    intrinsics[i] = value.get<double>();
+  }
+  LoadedFrame loaded;
+  loaded.rgbd =
+      MakeFrame(string_field("color"), string_field("depth"), json["depth_scale"].get<double>(), intrinsics, path);
+  return loaded;
+}
+
+}  // namespace ecv

@@ -1,0 +1,67 @@
+#pragma once
+
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/frame.h"
+#include "core/pose.h"
+
+namespace ecv {
+
+/// How a command names one frame (DESIGN.md, "Interfaces shared by every subcommand"): either one
+/// positional FRAME, or the flags --color, --depth, --depth-scale and --camera.
+struct FrameSpec {
+  /// A frame JSON, a YCB-Video prefix (".../0001/000001"), a BOP image "SCENE_DIR:IMAGE_ID" or an
+  /// organized ".pcd"; empty when the frame is given by flags.
+  std::string positional;
+  std::string color_path;             ///< --color: PNG or JPG
+  std::string depth_path;             ///< --depth: 16-bit PNG (also overrides a BOP image's depth)
+  std::optional<double> depth_scale;  ///< --depth-scale S: metres = depth value / S
+  std::optional<std::string> camera;  ///< --camera "fx,fy,cx,cy" in pixels
+};
+
+/// A frame with whatever ground truth its source provides (YCB-Video, BOP; none otherwise).
+struct LoadedFrame {
+  RgbdFrame rgbd;
+  std::vector<GroundTruth> ground_truth;
+};
+
+/// Loads the frame named by `spec`. Throws InputError naming the file and field on any broken input.
+LoadedFrame LoadFrame(const FrameSpec& spec);
+
+/// Colour image, PNG or JPG, as CV_8UC3 RGB.
+cv::Mat ReadColorImage(const std::string& path);
+
+/// 16-bit single-channel depth PNG to CV_32FC1 metres (value / `depth_scale`, 0 stays missing).
+cv::Mat ReadDepthImage(const std::string& path, double depth_scale);
+
+/// Parses "fx,fy,cx,cy" (pixels); names `source` on errors.
+std::array<double, 4> ParseIntrinsics(const std::string& text, const std::string& source);
+
+/// Frame from a colour image, a 16-bit depth PNG, a depth scale and intrinsics {fx, fy, cx, cy} in pixels.
+RgbdFrame MakeFrame(const std::string& color_path, const std::string& depth_path, double depth_scale,
+                    const std::array<double, 4>& intrinsics, const std::string& source);
+
+/// Frame JSON {"color", "depth", "depth_scale", "camera": [fx, fy, cx, cy]}, paths relative to it.
+LoadedFrame LoadFrameJson(const std::string& path);
+
+/// YCB-Video frame prefix ".../0001/000001": -color.png, -depth.png and -meta.mat (intrinsics,
+/// factor_depth and the ground-truth poses).
+LoadedFrame LoadYcbvFrame(const std::string& prefix);
+
+/// BOP image `image_id` of `scene_dir` (scene_camera.json, scene_gt.json, scene_gt_info.json,
+/// rgb/, depth/); `depth_override` replaces the depth image when not empty.
+LoadedFrame LoadBopFrame(const std::string& scene_dir, int image_id, const std::string& depth_override = "");
+
+/// Organized point cloud with colour (x y z rgb/rgba): depth = z, intrinsics fitted to the points.
+LoadedFrame LoadPcdFrame(const std::string& path);
+
+/// Organized cloud (CV_32FC3 metres, NaN missing) and colours (CV_8UC3 RGB) of a .pcd file.
+void ReadOrganizedPcd(const std::string& path, cv::Mat* points, cv::Mat* color);
+
+/// Name of a YCB-Video class index 1..21 ("003_cracker_box"); throws for other values.
+std::string YcbvClassName(int cls_index);
+
+}  // namespace ecv

@@ -1,0 +1,36 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "core/mesh.h"
+
+namespace ecv {
+
+/// How to read a mesh file into the object frame.
+struct MeshLoadOptions {
+  double metres_per_unit = 1.0;  ///< scale of the file's coordinates: 1 for metres, 0.001 for millimetres
+  /// Applied after the unit change: x_object = R x_mesh + t (t in metres).
+  Eigen::Isometry3d object_from_mesh = Eigen::Isometry3d::Identity();
+  /// When a referenced texture file is missing, use the material colour (with a warning) instead of
+  /// failing.
+  bool allow_missing_textures = false;
+
+  void Check() const;
+};
+
+/// Scale for a unit name: "m" -> 1, "mm" -> 0.001, "cm" -> 0.01; throws InputError otherwise.
+double MetresPerUnit(const std::string& unit);
+
+/// Loads OBJ (+MTL and texture images), PLY (vertex colours), glTF/GLB and the other formats assimp
+/// reads. Throws InputError for a missing or unreadable file, a mesh without triangles, or a missing
+/// texture (unless allowed); `warnings` (may be null) receives what was tolerated.
+TriangleMesh LoadMesh(const std::string& path, const MeshLoadOptions& options = {},
+                      std::vector<std::string>* warnings = nullptr);
+
+/// True for file extensions LoadMesh is meant for (.obj .ply .gltf .glb .stl .off .fbx .dae .3ds).
+bool LooksLikeMesh(const std::string& path);
+
+}  // namespace ecv

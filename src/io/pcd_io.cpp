@@ -1,0 +1,67 @@
+// Organized point clouds through PCL's io (kept in this one file: PCL headers are slow to compile).
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+
+#include <pcl/io/pcd_io.h>
+#include <pcl/point_types.h>
+
+#include "core/error.h"
+#include "io/frame_io.h"
+
+namespace ecv {
+
+void ReadOrganizedPcd(const std::string& path, cv::Mat* points, cv::Mat* color) {
+  if (!std::filesystem::exists(path)) ThrowInputError(path, "point cloud", "an existing .pcd file", "no such file");
+  pcl::PCLPointCloud2 header;
+  pcl::PCDReader reader;
+  Eigen::Vector4f origin;
+  Eigen::Quaternionf orientation;
+  int version = 0, data_type = 0;
+  unsigned int data_offset = 0;
+  if (reader.readHeader(path, header, origin, orientation, version, data_type, data_offset) < 0) {
+    ThrowInputError(path, "PCD header", "a valid PCD file");
+  }
+  bool has_color = false;
+  for (const pcl::PCLPointField& field : header.fields) has_color |= field.name == "rgb" || field.name == "rgba";
+  if (!has_color) ThrowInputError(path, "FIELDS", "x y z with rgb or rgba");
+  if (header.height <= 1) {
+    ThrowInputError(path, "HEIGHT", "an organized cloud (HEIGHT > 1, one point per pixel)",
+                    std::to_string(header.height));
+  }
+
+  pcl::PointCloud<pcl::PointXYZRGBA> cloud;
+  if (reader.read(path, cloud) < 0) ThrowInputError(path, "DATA", "readable point data");
+  const int width = static_cast<int>(cloud.width), height = static_cast<int>(cloud.height);
+  points->create(height, width, CV_32FC3);
+  color->create(height, width, CV_8UC3);
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      const pcl::PointXYZRGBA& p = cloud.at(u, v);
+      points->at<cv::Vec3f>(v, u) = {p.x, p.y, p.z};
+      color->at<cv::Vec3b>(v, u) = {p.r, p.g, p.b};
+    }
+  }
+}
+
+LoadedFrame LoadPcdFrame(const std::string& path) {
+  LoadedFrame loaded;
+  RgbdFrame& frame = loaded.rgbd;
+  frame.name = path;
+  cv::Mat points;
+  ReadOrganizedPcd(path, &points, &frame.color);
+  frame.depth.create(points.size(), CV_32FC1);
+  for (int v = 0; v < points.rows; ++v) {
+    for (int u = 0; u < points.cols; ++u) {
+      const cv::Vec3f& p = points.at<cv::Vec3f>(v, u);
+      const bool valid = std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]) && p[2] > 0.0F;
+      frame.depth.at<float>(v, u) = valid ? p[2] : 0.0F;
+    }
+  }
+  frame.camera = FitPinholeCamera(points, path).camera;
+  frame.Check();
+  return loaded;
+}
+
+}  // namespace ecv
