@@ -1,0 +1,36 @@
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+namespace ecv::test {
+
+/// Path inside the shared real data (../shared/data beside the checkout, or -DECVPOSE_DATA_DIR).
+/// Fails the test when the file is not there, naming the path.
+std::string DataPath(const std::string& relative);
+
+/// A fresh empty directory under the system's temporary directory, removed when it goes out of scope.
+class TemporaryDirectory {
+ public:
+  TemporaryDirectory();
+  ~TemporaryDirectory();
+  TemporaryDirectory(const TemporaryDirectory&) = delete;
+  TemporaryDirectory& operator=(const TemporaryDirectory&) = delete;
+
+  const std::filesystem::path& path() const { return path_; }
+  std::string File(const std::string& name) const { return (path_ / name).string(); }
+
+ private:
+  std::filesystem::path path_;
+};
+
+/// Output and exit code of a command run through the shell.
+struct CommandResult {
+  int exit_code = -1;
+  std::string output;  ///< standard output and standard error together
+};
+
+/// Runs the ecvpose tool with `arguments` (shell syntax).
+CommandResult RunCli(const std::string& arguments);
+
+}  // namespace ecv::test
