@@ -63,9 +63,9 @@ void LoadTexture(const aiScene& scene, const fs::path& mesh_dir, const std::stri
     const std::string message =
         mesh_path + ": material '" + material->name + "': texture '" + name + "' not found at " + file.string();
     if (!options.allow_missing_textures) {
-      throw InputError(message + " (give --allow-missing-textures to use the material colour instead)");
+      throw InputError(message + " (give --allow-missing-textures to use vertex or material colours instead)");
     }
-    if (warnings != nullptr) warnings->push_back(message + "; using the material colour");
+    if (warnings != nullptr) warnings->push_back(message + "; using vertex or material colours instead");
     material->texture_path.clear();
     return;
   }

@@ -14,7 +14,7 @@ struct MeshLoadOptions {
   double metres_per_unit = 1.0;  ///< scale of the file's coordinates: 1 for metres, 0.001 for millimetres
   /// Applied after the unit change: x_object = R x_mesh + t (t in metres).
   Eigen::Isometry3d object_from_mesh = Eigen::Isometry3d::Identity();
-  /// When a referenced texture file is missing, use the material colour (with a warning) instead of
+  /// When a referenced texture file is missing, use vertex or material colours (with a warning) instead of
   /// failing.
   bool allow_missing_textures = false;
 

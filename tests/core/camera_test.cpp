@@ -1,0 +1,81 @@
+#include <cmath>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "core/camera.h"
+#include "core/error.h"
+
+namespace ecv {
+namespace {
+
+const PinholeCamera kYcbvCamera{1066.778, 1067.487, 312.9869, 241.3109, 640, 480};
+
+TEST(PinholeCamera, ProjectInvertsBackProject) {
+  for (const Eigen::Vector2d& pixel :
+       {Eigen::Vector2d(0, 0), Eigen::Vector2d(639, 479), Eigen::Vector2d(100.25, 300.5)}) {
+    const Eigen::Vector3d point = kYcbvCamera.BackProject(pixel, 1.234);
+    EXPECT_DOUBLE_EQ(point.z(), 1.234);
+    EXPECT_LT((kYcbvCamera.Project(point) - pixel).norm(), 1e-9);
+  }
+}
+
+TEST(PinholeCamera, PrincipalPointProjectsTheOpticalAxis) {
+  const Eigen::Vector2d pixel = kYcbvCamera.Project({0.0, 0.0, 2.0});
+  EXPECT_DOUBLE_EQ(pixel.x(), kYcbvCamera.cx);
+  EXPECT_DOUBLE_EQ(pixel.y(), kYcbvCamera.cy);
+  // x right, y down: a point right of and below the axis lands right of and below the centre.
+  const Eigen::Vector2d right_below = kYcbvCamera.Project({0.1, 0.1, 1.0});
+  EXPECT_NEAR(right_below.x(), kYcbvCamera.cx + 106.6778, 1e-9);
+  EXPECT_NEAR(right_below.y(), kYcbvCamera.cy + 106.7487, 1e-9);
+}
+
+TEST(PinholeCamera, ContainsUsesPixelCentres) {
+  EXPECT_TRUE(kYcbvCamera.Contains({-0.49, -0.49}));
+  EXPECT_TRUE(kYcbvCamera.Contains({639.49, 479.49}));
+  EXPECT_FALSE(kYcbvCamera.Contains({639.5, 10}));
+  EXPECT_FALSE(kYcbvCamera.Contains({10, -0.6}));
+}
+
+TEST(PinholeCamera, CheckRejectsNonsense) {
+  EXPECT_NO_THROW(kYcbvCamera.Check());
+  PinholeCamera nan_focal = kYcbvCamera;
+  nan_focal.fx = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(nan_focal.Check(), InputError);
+  PinholeCamera negative = kYcbvCamera;
+  negative.fy = -5.0;
+  EXPECT_THROW(negative.Check(), InputError);
+  PinholeCamera no_size = kYcbvCamera;
+  no_size.width = 0;
+  EXPECT_THROW(no_size.Check(), InputError);
+}
+
+TEST(FitPinholeCamera, RecoversIntrinsicsOfASyntheticCloud) {
+  const PinholeCamera truth{570.0, 575.0, 321.5, 239.25, 64, 48};
+  cv::Mat points(truth.height, truth.width, CV_32FC3, cv::Scalar::all(std::numeric_limits<float>::quiet_NaN()));
+  for (int v = 0; v < truth.height; ++v) {
+    for (int u = 0; u < truth.width; ++u) {
+      if ((u + v) % 3 == 0) continue;  // leave holes
+      const Eigen::Vector3d p = truth.BackProject({u, v}, 0.8 + 0.01 * u);
+      points.at<cv::Vec3f>(v, u) =
+          cv::Vec3f(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
+    }
+  }
+  const CameraFit fit = FitPinholeCamera(points);
+  EXPECT_NEAR(fit.camera.fx, truth.fx, 0.05);
+  EXPECT_NEAR(fit.camera.fy, truth.fy, 0.05);
+  EXPECT_NEAR(fit.camera.cx, truth.cx, 0.05);
+  EXPECT_NEAR(fit.camera.cy, truth.cy, 0.05);
+  EXPECT_LT(fit.max_reprojection_px, 0.01);
+  EXPECT_EQ(fit.num_points, truth.width * truth.height - (truth.width * truth.height + 2) / 3);
+}
+
+TEST(FitPinholeCamera, RejectsCloudsWithoutEnoughPoints) {
+  cv::Mat points(4, 4, CV_32FC3, cv::Scalar::all(std::numeric_limits<float>::quiet_NaN()));
+  EXPECT_THROW(FitPinholeCamera(points), InputError);
+  points.setTo(cv::Scalar(0.0, 0.0, 1.0));  // all on the axis: no spread to fit a focal length
+  EXPECT_THROW(FitPinholeCamera(points), InputError);
+}
+
+}  // namespace
+}  // namespace ecv

@@ -1,0 +1,75 @@
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "core/mesh.h"
+
+namespace ecv {
+namespace {
+
+// A unit cube's 8 corners and 12 triangles.
+TriangleMesh Cube(double side) {
+  TriangleMesh mesh;
+  MeshPart part;
+  for (int i = 0; i < 8; ++i) {
+    part.positions.emplace_back(static_cast<float>(side * (i & 1)), static_cast<float>(side * ((i >> 1) & 1)),
+                                static_cast<float>(side * ((i >> 2) & 1)));
+  }
+  part.triangles = {{0, 1, 3}, {0, 3, 2}, {4, 6, 7}, {4, 7, 5}, {0, 4, 5}, {0, 5, 1},
+                    {2, 3, 7}, {2, 7, 6}, {0, 2, 6}, {0, 6, 4}, {1, 5, 7}, {1, 7, 3}};
+  mesh.parts.push_back(part);
+  return mesh;
+}
+
+TEST(TriangleMesh, CountsBoxAndDiameterOfACube) {
+  const TriangleMesh cube = Cube(0.1);
+  EXPECT_EQ(cube.NumVertices(), 8U);
+  EXPECT_EQ(cube.NumTriangles(), 12U);
+  EXPECT_LT((cube.BoundingBox().sizes() - Eigen::Vector3d::Constant(0.1)).norm(), 1e-7);
+  EXPECT_NEAR(cube.Diameter(), 0.1 * std::sqrt(3.0), 1e-7);
+}
+
+TEST(TriangleMesh, DiameterEqualsBruteForceOnRandomPoints) {
+  std::mt19937 random(7);
+  std::normal_distribution<float> normal(0.0F, 1.0F);
+  TriangleMesh mesh;
+  mesh.parts.emplace_back();
+  for (int i = 0; i < 2000; ++i)
+    mesh.parts[0].positions.emplace_back(normal(random), 0.3F * normal(random), normal(random));
+  double brute = 0.0;
+  const auto& p = mesh.parts[0].positions;
+  for (size_t i = 0; i < p.size(); ++i) {
+    for (size_t j = i + 1; j < p.size(); ++j)
+      brute = std::max(brute, (p[i].cast<double>() - p[j].cast<double>()).norm());
+  }
+  EXPECT_NEAR(mesh.Diameter(), brute, 1e-9);
+}
+
+TEST(TriangleMesh, ScaleThenTransformMovesPositionsAndNormals) {
+  TriangleMesh cube = Cube(100.0);  // millimetres
+  cube.parts[0].normals.assign(8, Eigen::Vector3f::UnitZ());
+  cube.Scale(0.001);
+  Eigen::Isometry3d object_from_mesh = Eigen::Isometry3d::Identity();
+  object_from_mesh.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  object_from_mesh.translation() = Eigen::Vector3d(0.0, 0.0, 0.5);
+  cube.Transform(object_from_mesh);
+  // Corner (0.1, 0.1, 0.1) -> rotated about x by 90 degrees -> (0.1, -0.1, 0.1) + (0, 0, 0.5).
+  EXPECT_LT((cube.parts[0].positions[7] - Eigen::Vector3f(0.1F, -0.1F, 0.6F)).norm(), 1e-6F);
+  EXPECT_LT((cube.parts[0].normals[0] - Eigen::Vector3f(0.0F, -1.0F, 0.0F)).norm(), 1e-6F);
+  EXPECT_NEAR(cube.Diameter(), 0.1 * std::sqrt(3.0), 1e-6);
+}
+
+TEST(TriangleMesh, ColoringPrefersTextureThenVertexColours) {
+  TriangleMesh mesh = Cube(1.0);
+  EXPECT_EQ(mesh.Coloring(mesh.parts[0]), MeshColoring::kMaterialColor);
+  mesh.parts[0].colors.assign(8, Eigen::Vector3f(1, 0, 0));
+  EXPECT_EQ(mesh.Coloring(mesh.parts[0]), MeshColoring::kVertexColor);
+  mesh.materials.push_back({"m", {1, 1, 1}, cv::Mat(4, 4, CV_8UC3, cv::Scalar(1, 2, 3)), "t.png"});
+  mesh.parts[0].material = 0;
+  EXPECT_EQ(mesh.Coloring(mesh.parts[0]), MeshColoring::kVertexColor);  // no texcoords yet
+  mesh.parts[0].texcoords.assign(8, Eigen::Vector2f(0.5F, 0.5F));
+  EXPECT_EQ(mesh.Coloring(mesh.parts[0]), MeshColoring::kTexture);
+}
+
+}  // namespace
+}  // namespace ecv

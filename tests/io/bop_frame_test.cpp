@@ -1,0 +1,83 @@
+// Real LM-O image 3 (BOP layout), with its depth image from SAM-6D's example (see lmo_subset/SOURCE.md).
+
+#include <algorithm>
+
+#include <gtest/gtest.h>
+
+#include "core/frame.h"
+#include "io/frame_io.h"
+#include "io/mesh_io.h"
+#include "support/test_data.h"
+
+namespace ecv {
+namespace {
+
+LoadedFrame LoadLmoImage3() {
+  FrameSpec spec;
+  spec.positional = test::DataPath("lmo_subset/data/bop/lmo/test/000002") + ":3";
+  spec.depth_path = test::DataPath("lmo_subset/SAM-6D/Data/Example/depth.png");
+  return LoadFrame(spec);
+}
+
+std::string ModelPath(int object_id) {
+  char name[32];
+  std::snprintf(name, sizeof(name), "obj_%06d.ply", object_id);
+  return test::DataPath(std::string("lmo_subset/data/bop/lmo/models/") + name);
+}
+
+TEST(BopFrame, ReadsLmoImageCameraAndEightPoses) {
+  const LoadedFrame loaded = LoadLmoImage3();
+  EXPECT_NEAR(loaded.rgbd.camera.fx, 572.4114, 1e-4);
+  EXPECT_NEAR(loaded.rgbd.camera.fy, 573.57043, 1e-4);
+  EXPECT_NEAR(loaded.rgbd.camera.cx, 325.2611, 1e-4);
+  EXPECT_NEAR(loaded.rgbd.camera.cy, 242.04899, 1e-4);
+  ASSERT_EQ(loaded.ground_truth.size(), 8U);
+  std::vector<int> ids;
+  for (const GroundTruth& truth : loaded.ground_truth) ids.push_back(truth.object_id);
+  EXPECT_EQ(ids, (std::vector<int>{1, 5, 6, 8, 9, 10, 11, 12}));
+  EXPECT_EQ(loaded.ground_truth[1].object_name, "obj_000005");
+  EXPECT_NEAR(loaded.ground_truth[0].visible_fraction, 0.1996, 1e-4);
+  EXPECT_EQ(loaded.ground_truth[1].object_box, cv::Rect(376, 226, 60, 91));
+  // Millimetres in scene_gt.json -> metres.
+  EXPECT_NEAR(loaded.ground_truth[1].camera_from_object.translation().z(), 0.96478389285, 1e-9);
+}
+
+TEST(BopFrame, ModelCentresProjectIntoTheirBoxes) {
+  const LoadedFrame loaded = LoadLmoImage3();
+  for (const GroundTruth& truth : loaded.ground_truth) {
+    const Eigen::Vector2d pixel = loaded.rgbd.camera.Project(truth.camera_from_object.translation());
+    const cv::Rect& box = truth.object_box;
+    EXPECT_TRUE(pixel.x() >= box.x && pixel.x() <= box.x + box.width && pixel.y() >= box.y &&
+                pixel.y() <= box.y + box.height)
+        << truth.object_name << " centre at (" << pixel.x() << ", " << pixel.y() << ")";
+  }
+}
+
+// Millimetre depth and millimetre models both end in metres: the median real depth in the visible box of
+// each at-least-half-visible object lies within the z range of its posed model widened by 2 cm.
+TEST(BopFrame, MedianDepthInVisibleBoxesLiesWithinPosedModelDepth) {
+  const LoadedFrame loaded = LoadLmoImage3();
+  MeshLoadOptions millimetres;
+  millimetres.metres_per_unit = 0.001;
+  int checked = 0;
+  for (const GroundTruth& truth : loaded.ground_truth) {
+    if (truth.visible_fraction < 0.5) continue;
+    const TriangleMesh model = LoadMesh(ModelPath(truth.object_id), millimetres);
+    double z_min = 1e9, z_max = -1e9;
+    for (const Eigen::Vector3f& point : model.parts[0].positions) {
+      const double z = (truth.camera_from_object * point.cast<double>()).z();
+      z_min = std::min(z_min, z);
+      z_max = std::max(z_max, z);
+    }
+    cv::Mat mask = cv::Mat::zeros(loaded.rgbd.depth.size(), CV_8UC1);
+    mask(truth.visible_box).setTo(255);
+    const DepthStats real = ComputeDepthStats(loaded.rgbd.depth, mask);
+    EXPECT_GE(real.median_m, z_min - 0.02) << truth.object_name;
+    EXPECT_LE(real.median_m, z_max + 0.02) << truth.object_name;
+    ++checked;
+  }
+  EXPECT_EQ(checked, 7);  // all but the ape (visib_fract 0.20)
+}
+
+}  // namespace
+}  // namespace ecv

@@ -1,0 +1,102 @@
+// Real YCB-Video frames: intrinsics, depth scale and ground truth read from -meta.mat agree with the
+// label image and the depth image.
+
+#include <algorithm>
+#include <map>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "core/frame.h"
+#include "io/frame_io.h"
+#include "io/points_io.h"
+#include "support/test_data.h"
+
+namespace ecv {
+namespace {
+
+std::string FramePrefix(const std::string& video, int frame) {
+  char name[16];
+  std::snprintf(name, sizeof(name), "%06d", frame);
+  return test::DataPath("ycbv_subset/Example-Scenes/" + video) + "/" + name;
+}
+
+const std::vector<Eigen::Vector3d>& ModelPoints(const std::string& name) {
+  static std::map<std::string, std::vector<Eigen::Vector3d>> cache;
+  auto found = cache.find(name);
+  if (found == cache.end()) {
+    found = cache.emplace(name, ReadXyzFile(test::DataPath("ycbv_subset/models/" + name + "/points.xyz"))).first;
+  }
+  return found->second;
+}
+
+TEST(YcbvFrame, ReadsImagesIntrinsicsAndDepthScale) {
+  FrameSpec spec;
+  spec.positional = FramePrefix("0001", 1);
+  const LoadedFrame loaded = LoadFrame(spec);
+  const RgbdFrame& frame = loaded.rgbd;
+  EXPECT_EQ(frame.color.size(), cv::Size(640, 480));
+  EXPECT_EQ(frame.depth.type(), CV_32FC1);
+  EXPECT_NEAR(frame.camera.fx, 1066.778, 1e-3);
+  EXPECT_NEAR(frame.camera.fy, 1067.487, 1e-3);
+  EXPECT_NEAR(frame.camera.cx, 312.9869, 1e-3);
+  EXPECT_NEAR(frame.camera.cy, 241.3109, 1e-3);
+  // Depth = PNG value / 10000: compare one pixel with the raw PNG.
+  const cv::Mat raw = cv::imread(spec.positional + "-depth.png", cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(raw.type(), CV_16UC1);
+  EXPECT_FLOAT_EQ(frame.depth.at<float>(240, 320), raw.at<uint16_t>(240, 320) / 10000.0F);
+  // Colour is RGB: the PNG on disk decodes as BGR in OpenCV.
+  const cv::Mat bgr = cv::imread(spec.positional + "-color.png", cv::IMREAD_COLOR);
+  EXPECT_EQ(frame.color.at<cv::Vec3b>(100, 100)[0], bgr.at<cv::Vec3b>(100, 100)[2]);
+  EXPECT_EQ(frame.color.at<cv::Vec3b>(100, 100)[2], bgr.at<cv::Vec3b>(100, 100)[0]);
+
+  std::vector<std::string> names;
+  for (const GroundTruth& truth : loaded.ground_truth) names.push_back(truth.object_name);
+  EXPECT_EQ(names, (std::vector<std::string>{"002_master_chef_can", "003_cracker_box", "004_sugar_box",
+                                             "006_mustard_bottle"}));
+}
+
+// The check on 0001/000001: each object's origin projects onto its own label pixels.
+TEST(YcbvFrame, GroundTruthOriginsProjectOntoTheirLabels) {
+  const std::string prefix = FramePrefix("0001", 1);
+  const LoadedFrame loaded = LoadYcbvFrame(prefix);
+  const cv::Mat label = cv::imread(prefix + "-label.png", cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(loaded.ground_truth.size(), 4U);
+  for (const GroundTruth& truth : loaded.ground_truth) {
+    const Eigen::Vector2d pixel = loaded.rgbd.camera.Project(truth.camera_from_object.translation());
+    ASSERT_TRUE(loaded.rgbd.camera.Contains(pixel)) << truth.object_name;
+    const int u = static_cast<int>(std::lround(pixel.x())), v = static_cast<int>(std::lround(pixel.y()));
+    EXPECT_EQ(label.at<uint8_t>(v, u), truth.object_id) << truth.object_name << " at (" << u << ", " << v << ")";
+  }
+}
+
+// On all 30 frames: the median real depth over an object's label pixels lies within the z range of its
+// points.xyz under the ground-truth pose, widened by 1 cm. A wrong depth scale or pose convention fails.
+TEST(YcbvFrame, MedianDepthOverLabelsLiesWithinPosedModelDepth) {
+  int checked = 0;
+  for (const char* video : {"0000", "0001", "0002"}) {
+    for (int frame_number = 1; frame_number <= 19; frame_number += 2) {
+      const std::string prefix = FramePrefix(video, frame_number);
+      const LoadedFrame loaded = LoadYcbvFrame(prefix);
+      const cv::Mat label = cv::imread(prefix + "-label.png", cv::IMREAD_UNCHANGED);
+      for (const GroundTruth& truth : loaded.ground_truth) {
+        const cv::Mat mask = label == truth.object_id;
+        if (cv::countNonZero(mask) < 200) continue;  // hardly visible: the median says little
+        const DepthStats real = ComputeDepthStats(loaded.rgbd.depth, mask);
+        double z_min = 1e9, z_max = -1e9;
+        for (const Eigen::Vector3d& point : ModelPoints(truth.object_name)) {
+          const double z = (truth.camera_from_object * point).z();
+          z_min = std::min(z_min, z);
+          z_max = std::max(z_max, z);
+        }
+        EXPECT_GE(real.median_m, z_min - 0.01) << prefix << " " << truth.object_name;
+        EXPECT_LE(real.median_m, z_max + 0.01) << prefix << " " << truth.object_name;
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GE(checked, 100);  // 10 frames x (3 + 4 + 6) objects, less the hardly visible ones
+}
+
+}  // namespace
+}  // namespace ecv

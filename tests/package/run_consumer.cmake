@@ -1,0 +1,20 @@
+# Installs ecvpose into a temporary prefix, builds tests/package/consumer against it and runs it on a
+# real frame. Called by ctest with -DSOURCE_DIR -DBUILD_DIR -DDATA_DIR.
+set(work "${BUILD_DIR}/package_consumer")
+file(REMOVE_RECURSE "${work}")
+function(run)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE out)
+  if(NOT code EQUAL 0)
+    message(FATAL_ERROR "failed (${code}): ${ARGN}\n${out}")
+  endif()
+  set(output "${out}" PARENT_SCOPE)
+endfunction()
+run(${CMAKE_COMMAND} --install "${BUILD_DIR}" --prefix "${work}/prefix")
+run(${CMAKE_COMMAND} -S "${SOURCE_DIR}/tests/package/consumer" -B "${work}/build"
+    -DCMAKE_PREFIX_PATH=${work}/prefix -DCMAKE_BUILD_TYPE=Release)
+run(${CMAKE_COMMAND} --build "${work}/build")
+run("${work}/build/frame_info" "${DATA_DIR}/ycbv_subset/Example-Scenes/0001/000001")
+if(NOT output MATCHES "^1066.78 4")
+  message(FATAL_ERROR "unexpected output of the consumer: ${output}")
+endif()
+message(STATUS "consumer printed: ${output}")
