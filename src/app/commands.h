@@ -23,5 +23,7 @@ struct Subcommand {
 };
 
 CommandAction SetupInfoCommand(CLI::App& command);
+CommandAction SetupFeaturesCommand(CLI::App& command);
+CommandAction SetupRenderCommand(CLI::App& command);  // render/render_command.cpp
 
 }  // namespace ecv::app

@@ -16,6 +16,10 @@ using ecv::app::Subcommand;
 const Subcommand kSubcommands[] = {
     {"info", "Describe RGB-D frames (size, camera, depth) and meshes (size, colouring, diameter)",
      ecv::app::SetupInfoCommand},
+    {"features", "Extract ECV primitives (segments, texlets) of a frame; counts, picture, PLY",
+     ecv::app::SetupFeaturesCommand},
+    {"render", "Render a mesh's views (RGB, metric depth, mask), a model over a frame, or a scene",
+     ecv::app::SetupRenderCommand},
 };
 
 }  // namespace

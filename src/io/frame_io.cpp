@@ -103,6 +103,19 @@ cv::Mat ReadColorImage(const std::string& path) {
   return rgb;
 }
 
+void WriteColorImage(const std::string& path, const cv::Mat& image) {
+  CV_Assert(image.type() == CV_8UC3 || image.type() == CV_8UC1);
+  cv::Mat converted = image;
+  if (image.channels() == 3) cv::cvtColor(image, converted, cv::COLOR_RGB2BGR);
+  bool written = false;
+  try {
+    written = cv::imwrite(path, converted);
+  } catch (const cv::Exception& error) {
+    ThrowInputError(path, "image", "a writable .png or .jpg path", error.what());
+  }
+  if (!written) ThrowInputError(path, "image", "a writable .png or .jpg path");
+}
+
 cv::Mat ReadDepthImage(const std::string& path, double depth_scale) {
   if (!std::isfinite(depth_scale) || depth_scale <= 0.0) {
     ThrowInputError(path, "depth_scale", "a finite positive scale (metres = value / scale)",

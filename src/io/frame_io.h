@@ -34,6 +34,9 @@ LoadedFrame LoadFrame(const FrameSpec& spec);
 /// Colour image, PNG or JPG, as CV_8UC3 RGB.
 cv::Mat ReadColorImage(const std::string& path);
 
+/// Writes a CV_8UC3 RGB (or CV_8UC1) image as PNG or JPG; throws InputError if it cannot.
+void WriteColorImage(const std::string& path, const cv::Mat& image);
+
 /// 16-bit single-channel depth PNG to CV_32FC1 metres (value / `depth_scale`, 0 stays missing).
 cv::Mat ReadDepthImage(const std::string& path, double depth_scale);
 

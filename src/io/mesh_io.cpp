@@ -6,6 +6,8 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -14,6 +16,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
+#include "core/pose.h"
 #include "io/frame_io.h"
 
 namespace ecv {
@@ -132,6 +135,26 @@ double MetresPerUnit(const std::string& unit) {
   if (unit == "cm") return 0.01;
   if (unit == "mm") return 0.001;
   ThrowInputError("--unit", "unit", "m, cm or mm", "'" + unit + "'");
+}
+
+std::map<std::string, Eigen::Isometry3d> ReadTransformTable(const std::string& path) {
+  std::ifstream stream(path);
+  if (!stream) ThrowInputError(path, "transform table", "a readable file");
+  std::map<std::string, Eigen::Isometry3d> table;
+  std::string line;
+  for (int number = 1; std::getline(stream, line); ++number) {
+    if (line.find_first_not_of(" \t\r") == std::string::npos || line[0] == '#') continue;
+    std::istringstream fields(line);
+    std::string name;
+    Eigen::Matrix4d matrix = Eigen::Matrix4d::Identity();
+    fields >> name;
+    for (int r = 0; r < 3; ++r) fields >> matrix(r, 0) >> matrix(r, 1) >> matrix(r, 2);
+    fields >> matrix(0, 3) >> matrix(1, 3) >> matrix(2, 3);
+    const std::string where = "line " + std::to_string(number);
+    if (!fields) ThrowInputError(path, where, "a name and 12 numbers (R row-major, then t)", "'" + line + "'");
+    table[name] = RigidFromMatrix(matrix, path, where);
+  }
+  return table;
 }
 
 bool LooksLikeMesh(const std::string& path) {

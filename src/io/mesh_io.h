@@ -1,5 +1,6 @@
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,11 @@ double MetresPerUnit(const std::string& unit);
 /// texture (unless allowed); `warnings` (may be null) receives what was tolerated.
 TriangleMesh LoadMesh(const std::string& path, const MeshLoadOptions& options = {},
                       std::vector<std::string>* warnings = nullptr);
+
+/// Rigid transforms by name from a text table with lines "name r11 r12 r13 r21 r22 r23 r31 r32 r33 tx ty tz
+/// [anything]" ('#' starts a comment), such as YCB's derived/google16k_to_ycbv.txt (p_to = R p_from + t,
+/// metres). Throws InputError naming the file and line on a malformed row or a non-rigid matrix.
+std::map<std::string, Eigen::Isometry3d> ReadTransformTable(const std::string& path);
 
 /// True for file extensions LoadMesh is meant for (.obj .ply .gltf .glb .stl .off .fbx .dae .3ds).
 bool LooksLikeMesh(const std::string& path);

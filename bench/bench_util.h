@@ -1,0 +1,31 @@
+#pragma once
+
+#include <chrono>
+#include <string>
+#include <vector>
+
+namespace ecv::bench {
+
+using Clock = std::chrono::steady_clock;
+
+/// Milliseconds since `start`.
+double MillisecondsSince(Clock::time_point start);
+
+/// "Intel(R) Xeon(R) ... (2 cores)" from /proc/cpuinfo and the scheduler.
+std::string MachineDescription();
+
+/// The command line, for the record.
+std::string CommandLine(int argc, char** argv);
+
+/// `value` with `decimals` digits after the point.
+std::string Fixed(double value, int decimals);
+
+/// Median of `values` (copied); 0 for none.
+double Median(std::vector<double> values);
+
+/// Prints `markdown` and appends it to `results_path` under a heading with `title`, the date, the machine
+/// and the command.
+void Report(const std::string& results_path, const std::string& title, const std::string& command,
+            const std::string& markdown);
+
+}  // namespace ecv::bench

@@ -1,0 +1,34 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "core/frame.h"
+#include "ecv/primitives.h"
+
+namespace ecv::bench {
+
+/// One view of an object: an image, the object's pixels and its pose in the view's camera.
+struct ObjectView {
+  std::string name;  ///< e.g. "0001/000007" or "rendered view 42"
+  RgbdFrame rgbd;
+  cv::Mat mask;                          ///< CV_8UC1, the object's pixels
+  Eigen::Isometry3d camera_from_object;  ///< metres
+};
+
+/// Two views of one object with known relative pose: query (model side) and train (scene side).
+struct ViewPair {
+  std::string set;     ///< "recognition", "hard" or "easy"
+  std::string object;  ///< "003_cracker_box"
+  bool held_out;       ///< from video 0002: not used to choose parameters
+  ObjectView query, train;
+
+  Eigen::Isometry3d TrainFromQuery() const { return train.camera_from_object * query.camera_from_object.inverse(); }
+};
+
+/// The pairs of the three sets on the YCB-Video frames under `data_dir` (renders with OSMesa).
+std::vector<ViewPair> LoadViewPairs(const std::string& data_dir);
+
+}  // namespace ecv::bench

@@ -1,0 +1,38 @@
+#pragma once
+
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "ecv/primitives.h"
+
+namespace ecv {
+
+/// Length of an ECV context descriptor: six 16-bin histograms.
+inline constexpr int kDescriptorBins = 16;
+inline constexpr int kDescriptorSize = 6 * kDescriptorBins;
+
+/// The ECV context descriptor (paper Sect. II-B; DESIGN.md "Context descriptor").
+struct DescriptorOptions {
+  double radius_m = 0.025;         ///< context radius around each primitive, metres
+  bool unsigned_segments = false;  ///< a segment's direction has no sign: use |cosines| that involve one
+  bool soft_binning = false;       ///< share each value between its two nearest bins (linear)
+  bool use_color = true;           ///< false: shape only (the three colour histograms stay zero)
+  bool hellinger = false;          ///< store square roots of the histogram values (L2 then = Hellinger)
+
+  void Check() const;
+};
+
+/// Descriptors of the primitives that have a context (at least one other primitive within the radius).
+struct Descriptors {
+  cv::Mat values;              ///< one row of kDescriptorSize CV_32F per described primitive
+  std::vector<int> primitive;  ///< index into the input primitives of each row
+};
+
+/// For each primitive s, every pair {a, b} of the primitives within `radius_m` of s (s included), ordered
+/// so that a is the closer to s, d = (p_b - p_a) / |p_b - p_a|, adds R_G1 = o_a.o_b, R_G2 = o_a.d,
+/// R_G3 = o_b.d and R_Ak = c_b[k] - c_a[k] to six 16-bin histograms over [-1, 1] (over [0, 1] for
+/// unsigned cosines), each normalised to sum 1. Neighbours of both types form the context.
+Descriptors ComputeDescriptors(const std::vector<Primitive>& primitives, const DescriptorOptions& options = {});
+
+}  // namespace ecv

@@ -1,0 +1,145 @@
+#include "ecv/matching.h"
+
+#include <cmath>
+#include <string>
+
+#include <flann/algorithms/dist.h>
+#include <flann/algorithms/kdtree_index.h>
+#include <flann/algorithms/kdtree_single_index.h>
+#include <flann/algorithms/linear_index.h>
+
+#include "core/error.h"
+
+namespace ecv {
+
+// One FLANN index over the train descriptors of one type (or of all), with the rows' primitive indices.
+struct DescriptorMatcher::Index {
+  cv::Mat values;              // owned copy: FLANN keeps pointers into it
+  std::vector<int> primitive;  // train primitive of each row
+  std::unique_ptr<flann::NNIndex<flann::L2<float>>> index;
+};
+
+namespace {
+
+// Rows of `descriptors` whose primitive passes `keep`.
+template <typename Keep>
+void SelectRows(const Descriptors& descriptors, Keep keep, cv::Mat* values, std::vector<int>* primitive) {
+  std::vector<int> rows;
+  for (size_t row = 0; row < descriptors.primitive.size(); ++row) {
+    if (keep(descriptors.primitive[row])) rows.push_back(static_cast<int>(row));
+  }
+  values->create(static_cast<int>(rows.size()), kDescriptorSize, CV_32F);
+  primitive->clear();
+  for (size_t i = 0; i < rows.size(); ++i) {
+    descriptors.values.row(rows[i]).copyTo(values->row(static_cast<int>(i)));
+    primitive->push_back(descriptors.primitive[static_cast<size_t>(rows[i])]);
+  }
+}
+
+flann::Matrix<float> AsFlann(const cv::Mat& values) {
+  return {const_cast<float*>(values.ptr<float>()), static_cast<size_t>(values.rows), static_cast<size_t>(values.cols)};
+}
+
+}  // namespace
+
+void MatchOptions::Check() const {
+  if (k < 1) ThrowInputError("match options", "k", "at least 1 neighbour", std::to_string(k));
+  if (trees < 1 || checks < 1) ThrowInputError("match options", "trees/checks", "positive values");
+}
+
+DescriptorMatcher::DescriptorMatcher(const std::vector<Primitive>& train_primitives, const Descriptors& train,
+                                     const MatchOptions& options)
+    : options_(options) {
+  options_.Check();
+  const int types = options_.structure_specific ? 2 : 1;
+  for (int type = 0; type < types; ++type) {
+    auto index = std::make_unique<Index>();
+    SelectRows(
+        train,
+        [&](int i) { return types == 1 || static_cast<int>(train_primitives[static_cast<size_t>(i)].type) == type; },
+        &index->values, &index->primitive);
+    if (index->values.rows > 0) {
+      const flann::Matrix<float> data = AsFlann(index->values);
+      if (index->values.rows < options_.exact_below) {
+        index->index = std::make_unique<flann::LinearIndex<flann::L2<float>>>(data);
+      } else {
+        index->index =
+            std::make_unique<flann::KDTreeIndex<flann::L2<float>>>(data, flann::KDTreeIndexParams(options_.trees));
+      }
+      index->index->buildIndex();
+    }
+    indices_.push_back(std::move(index));
+  }
+}
+
+DescriptorMatcher::~DescriptorMatcher() = default;
+
+std::vector<DescriptorMatch> DescriptorMatcher::Match(const std::vector<Primitive>& query_primitives,
+                                                      const Descriptors& query) const {
+  std::vector<DescriptorMatch> matches;
+  for (size_t type = 0; type < indices_.size(); ++type) {
+    const Index& index = *indices_[type];
+    if (!index.index) continue;
+    cv::Mat values;
+    std::vector<int> primitive;
+    SelectRows(
+        query,
+        [&](int i) {
+          return indices_.size() == 1 || static_cast<size_t>(query_primitives[static_cast<size_t>(i)].type) == type;
+        },
+        &values, &primitive);
+    if (values.rows == 0) continue;
+    const int k = std::min(options_.k, index.values.rows);
+    std::vector<std::vector<size_t>> neighbours;
+    std::vector<std::vector<float>> squared;
+    flann::SearchParams search(options_.checks);
+    search.sorted = true;
+    index.index->knnSearch(AsFlann(values), neighbours, squared, static_cast<size_t>(k), search);
+    for (size_t q = 0; q < neighbours.size(); ++q) {
+      for (size_t rank = 0; rank < neighbours[q].size(); ++rank) {
+        matches.push_back(
+            {primitive[q], index.primitive[neighbours[q][rank]], std::sqrt(squared[q][rank]), static_cast<int>(rank)});
+      }
+    }
+  }
+  return matches;
+}
+
+CorrespondenceScore ScoreCorrespondences(const std::vector<Primitive>& query, const std::vector<Primitive>& train,
+                                         const std::vector<DescriptorMatch>& matches,
+                                         const Eigen::Isometry3d& train_from_query, double threshold_m) {
+  CorrespondenceScore score;
+  const Eigen::Isometry3f transform = train_from_query.cast<float>();
+  const float squared = static_cast<float>(threshold_m * threshold_m);
+  for (const DescriptorMatch& match : matches) {
+    if (match.rank != 0) continue;
+    ++score.hypotheses;
+    const Eigen::Vector3f moved = transform * query[static_cast<size_t>(match.query)].position;
+    score.true_matches += (moved - train[static_cast<size_t>(match.train)].position).squaredNorm() < squared ? 1 : 0;
+  }
+  return score;
+}
+
+double TruePartnerFraction(const std::vector<Primitive>& query, const std::vector<int>& query_indices,
+                           const std::vector<Primitive>& train, const Eigen::Isometry3d& train_from_query,
+                           double threshold_m) {
+  if (query_indices.empty() || train.empty()) return 0.0;
+  std::vector<float> positions(3 * train.size());
+  for (size_t i = 0; i < train.size(); ++i) std::copy_n(train[i].position.data(), 3, &positions[3 * i]);
+  flann::KDTreeSingleIndex<flann::L2_Simple<float>> index(flann::Matrix<float>(positions.data(), train.size(), 3));
+  index.buildIndex();
+  const Eigen::Isometry3f transform = train_from_query.cast<float>();
+  int with_partner = 0;
+  std::vector<size_t> nearest(1);
+  std::vector<float> squared(1);
+  for (const int i : query_indices) {
+    Eigen::Vector3f moved = transform * query[static_cast<size_t>(i)].position;
+    flann::Matrix<size_t> nearest_matrix(nearest.data(), 1, 1);
+    flann::Matrix<float> squared_matrix(squared.data(), 1, 1);
+    index.knnSearch(flann::Matrix<float>(moved.data(), 1, 3), nearest_matrix, squared_matrix, 1, flann::SearchParams());
+    with_partner += squared[0] < threshold_m * threshold_m ? 1 : 0;
+  }
+  return static_cast<double>(with_partner) / static_cast<double>(query_indices.size());
+}
+
+}  // namespace ecv

@@ -1,0 +1,68 @@
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "ecv/descriptor.h"
+
+namespace ecv {
+
+/// Nearest-neighbour matching of context descriptors (FLANN).
+struct MatchOptions {
+  int k = 1;                       ///< neighbours returned per query descriptor
+  bool structure_specific = true;  ///< segments only against segments, texlets only against texlets
+  int exact_below = 4000;          ///< a train set smaller than this is searched exactly (linear scan)
+  int trees = 4;                   ///< randomised kd-trees of the approximate index
+  int checks = 128;                ///< leaves visited per query by the approximate search
+
+  void Check() const;
+};
+
+/// A query primitive matched to a train primitive (indices into the primitive vectors).
+struct DescriptorMatch {
+  int query = -1;
+  int train = -1;
+  float distance = 0.0F;  ///< Euclidean distance between the descriptors
+  int rank = 0;           ///< 0 for the nearest, 1 for the second, ...
+};
+
+/// An index over the descriptors of one primitive set (e.g. the scene), queried with another's (a model
+/// view's). Built once, queried many times.
+class DescriptorMatcher {
+ public:
+  DescriptorMatcher(const std::vector<Primitive>& train_primitives, const Descriptors& train,
+                    const MatchOptions& options = {});
+  ~DescriptorMatcher();
+  DescriptorMatcher(const DescriptorMatcher&) = delete;
+  DescriptorMatcher& operator=(const DescriptorMatcher&) = delete;
+
+  /// The k nearest train descriptors of each query descriptor (of the same type when structure-specific).
+  std::vector<DescriptorMatch> Match(const std::vector<Primitive>& query_primitives, const Descriptors& query) const;
+
+ private:
+  struct Index;
+  MatchOptions options_;
+  std::vector<std::unique_ptr<Index>> indices_;  // one per primitive type, or one for all
+};
+
+/// The paper's correspondence score (Sect. IV-A) of some matches.
+struct CorrespondenceScore {
+  int hypotheses = 0;    ///< C_hyp: matches scored
+  int true_matches = 0;  ///< C_true: matches whose points lie within the threshold after alignment
+  double Score() const { return hypotheses > 0 ? static_cast<double>(true_matches) / hypotheses : 0.0; }
+};
+
+/// Scores the rank-0 matches: true when |train_from_query * p_query - p_train| < `threshold_m`.
+CorrespondenceScore ScoreCorrespondences(const std::vector<Primitive>& query, const std::vector<Primitive>& train,
+                                         const std::vector<DescriptorMatch>& matches,
+                                         const Eigen::Isometry3d& train_from_query, double threshold_m = 0.01);
+
+/// Ceiling of the score: the fraction of `query_indices` whose primitive has any train primitive within
+/// `threshold_m` after alignment.
+double TruePartnerFraction(const std::vector<Primitive>& query, const std::vector<int>& query_indices,
+                           const std::vector<Primitive>& train, const Eigen::Isometry3d& train_from_query,
+                           double threshold_m = 0.01);
+
+}  // namespace ecv
