@@ -4,13 +4,18 @@
 // random matching and the ceiling. Also the ablations that set the descriptor's defaults, a bar chart and
 // a picture of matches. Writes to bench/RESULTS.md and bench/figures/.
 //
-//   discriminative_bench [--results FILE] [--figures DIR] [--quick]
+//   discriminative_bench [--results FILE] [--figures DIR] [--ablations-only] [--variants TEXT]
+//                        [--library-distance M]
 
+#include <algorithm>
+#include <cstdlib>
 #include <cstring>
 #include <functional>
 #include <iostream>
 #include <map>
 #include <random>
+
+#include <opencv2/imgcodecs.hpp>
 
 #include <opencv2/core.hpp>
 #include <opencv2/features2d.hpp>
@@ -189,6 +194,176 @@ std::string SetTable(const std::string& set, const std::vector<ViewPair>& pairs,
   return table + "\n\n";
 }
 
+// Bar chart of the mean score per method and set, random matching as a grey tick (BGR image for imwrite).
+cv::Mat BarChart(const std::vector<ViewPair>& pairs, const std::vector<std::string>& names,
+                 const std::vector<std::vector<PairScore>>& scores) {
+  const std::vector<std::string> sets = {"recognition", "hard", "easy"};
+  const int bar = 14, gap = 30, height = 300, top = 40, left = 50;
+  const int group = static_cast<int>(names.size()) * bar;
+  cv::Mat canvas(top + height + 190, left + static_cast<int>(sets.size()) * (group + gap) + 20, CV_8UC3,
+                 cv::Scalar::all(255));
+  for (int percent = 0; percent <= 100; percent += 20) {
+    const int y = top + height - height * percent / 100;
+    cv::line(canvas, {left - 5, y}, {canvas.cols - 10, y}, cv::Scalar::all(225));
+    cv::putText(canvas, std::to_string(percent) + "%", {5, y + 4}, cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar::all(80));
+  }
+  for (size_t s = 0; s < sets.size(); ++s) {
+    const int x0 = left + static_cast<int>(s) * (group + gap);
+    for (size_t m = 0; m < names.size(); ++m) {
+      double sum = 0.0, random = 0.0;
+      int count = 0;
+      for (size_t i = 0; i < pairs.size(); ++i) {
+        if (pairs[i].set != sets[s]) continue;
+        sum += scores[i][m].score;
+        random += scores[i][m].random;
+        ++count;
+      }
+      const double mean = count > 0 ? sum / count : 0.0;
+      const int x = x0 + static_cast<int>(m) * bar;
+      const cv::Scalar color = m == 0 ? cv::Scalar(40, 40, 220) : cv::Scalar(170 - 10.0 * m, 140, 60 + 12.0 * m);
+      cv::rectangle(canvas, {x + 1, top + height - static_cast<int>(height * mean)}, {x + bar - 2, top + height}, color,
+                    cv::FILLED);
+      const int random_y = top + height - static_cast<int>(height * (count > 0 ? random / count : 0.0));
+      cv::line(canvas, {x, random_y}, {x + bar - 1, random_y}, cv::Scalar::all(60), 2);
+    }
+    cv::putText(canvas, sets[s], {x0, top + height + 18}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar::all(0));
+  }
+  for (size_t m = 0; m < names.size(); ++m) {
+    const cv::Scalar color = m == 0 ? cv::Scalar(40, 40, 220) : cv::Scalar(170 - 10.0 * m, 140, 60 + 12.0 * m);
+    const int y = top + height + 40 + static_cast<int>(m) * 14;
+    cv::rectangle(canvas, {left, y - 9}, {left + 10, y}, color, cv::FILLED);
+    cv::putText(canvas, names[m], {left + 16, y}, cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar::all(0));
+  }
+  cv::putText(canvas, "True NN matches within 1 cm (grey: random)", {left, 22}, cv::FONT_HERSHEY_SIMPLEX, 0.5,
+              cv::Scalar::all(0));
+  return canvas;
+}
+
+// The paper's Fig. 6: 25 random ECV matches of one pair, green when true, red when false (BGR image).
+cv::Mat MatchPicture(const ViewPair& pair, const PairPrimitives& primitives) {
+  const Descriptors query = ComputeDescriptors(primitives.query), train = ComputeDescriptors(primitives.train);
+  const DescriptorMatcher matcher(primitives.train, train);
+  std::vector<DescriptorMatch> matches = matcher.Match(primitives.query, query);
+  std::mt19937 random(5);
+  std::shuffle(matches.begin(), matches.end(), random);
+  cv::Mat left, right, canvas;
+  cv::cvtColor(pair.query.rgbd.color, left, cv::COLOR_RGB2BGR);
+  cv::cvtColor(pair.train.rgbd.color, right, cv::COLOR_RGB2BGR);
+  cv::hconcat(left, right, canvas);
+  const Eigen::Isometry3f train_from_query = pair.TrainFromQuery().cast<float>();
+  for (size_t k = 0; k < std::min<size_t>(25, matches.size()); ++k) {
+    const Primitive& q = primitives.query[static_cast<size_t>(matches[k].query)];
+    const Primitive& t = primitives.train[static_cast<size_t>(matches[k].train)];
+    const bool correct = (train_from_query * q.position - t.position).norm() < kTrueMatch;
+    const cv::Scalar color = correct ? cv::Scalar(60, 220, 60) : cv::Scalar(40, 40, 230);
+    const cv::Point a(cvRound(q.pixel.x()), cvRound(q.pixel.y()));
+    const cv::Point b(cvRound(t.pixel.x()) + left.cols, cvRound(t.pixel.y()));
+    cv::line(canvas, a, b, color, 1, cv::LINE_AA);
+    cv::circle(canvas, a, 3, color, cv::FILLED, cv::LINE_AA);
+    cv::circle(canvas, b, 3, color, cv::FILLED, cv::LINE_AA);
+  }
+  cv::putText(canvas, pair.object + ": " + pair.query.name + " (left) vs real " + pair.train.name + "; green = true",
+              {10, 20}, cv::FONT_HERSHEY_SIMPLEX, 0.55, cv::Scalar::all(255), 1, cv::LINE_AA);
+  return canvas;
+}
+
+// One ECV variant of the ablation study.
+struct Variant {
+  std::string name;
+  EcvOptions extraction;
+  DescriptorOptions descriptor;
+  MatchOptions matching;
+};
+
+std::vector<Variant> Variants() {
+  std::vector<Variant> variants;
+  auto add = [&](const std::string& name, const std::function<void(Variant&)>& change) {
+    Variant variant{name, {}, {}, {}};
+    change(variant);
+    variants.push_back(variant);
+  };
+  add("**current defaults**", [](Variant&) {});
+  add("paper's descriptor: signed, hard bins, L2, structure-specific", [](Variant& v) {
+    v.descriptor.unsigned_segments = false;
+    v.descriptor.soft_binning = false;
+    v.descriptor.hellinger = false;
+    v.matching.structure_specific = true;
+  });
+  add("unsigned segment directions",
+      [](Variant& v) { v.descriptor.unsigned_segments = !DescriptorOptions{}.unsigned_segments; });
+  add("soft binning", [](Variant& v) { v.descriptor.soft_binning = !DescriptorOptions{}.soft_binning; });
+  add("Hellinger distance", [](Variant& v) { v.descriptor.hellinger = !DescriptorOptions{}.hellinger; });
+  add("mixed matching (not structure-specific)",
+      [](Variant& v) { v.matching.structure_specific = !MatchOptions{}.structure_specific; });
+  add("grey-world colour balance",
+      [](Variant& v) { v.descriptor.balance_colors = !DescriptorOptions{}.balance_colors; });
+  add("shape only (no colour histograms)", [](Variant& v) { v.descriptor.use_color = false; });
+  add("radius 0.015 m", [](Variant& v) { v.descriptor.radius_m = 0.015; });
+  add("radius 0.035 m", [](Variant& v) { v.descriptor.radius_m = 0.035; });
+  add("at most 24 neighbours", [](Variant& v) { v.descriptor.max_neighbours = 24; });
+  add("at most 48 neighbours", [](Variant& v) { v.descriptor.max_neighbours = 48; });
+  add("wavelength 6 px", [](Variant& v) { v.extraction.monogenic.wavelength_px = 6; });
+  add("wavelength 8 px", [](Variant& v) { v.extraction.monogenic.wavelength_px = 8; });
+  add("wavelength 16 px", [](Variant& v) { v.extraction.monogenic.wavelength_px = 16; });
+  add("grid spacing 6 px", [](Variant& v) { v.extraction.grid_spacing_px = 6; });
+  add("grid spacing 7 px", [](Variant& v) { v.extraction.grid_spacing_px = 7; });
+  add("grid spacing 10 px", [](Variant& v) { v.extraction.grid_spacing_px = 10; });
+  add("min magnitude 0.01", [](Variant& v) { v.extraction.min_magnitude = 0.01; });
+  add("min magnitude 0.04", [](Variant& v) { v.extraction.min_magnitude = 0.04; });
+  add("max edge variance 0.15", [](Variant& v) { v.extraction.max_edge_variance = 0.15; });
+  add("max edge variance 0.35", [](Variant& v) { v.extraction.max_edge_variance = 0.35; });
+  add("no edge NMS", [](Variant& v) { v.extraction.edge_nms = false; });
+  return variants;
+}
+
+// True when `filter` is empty or one of its '|'-separated parts occurs in `name`.
+bool MatchesFilter(const std::string& name, const std::string& filter) {
+  if (filter.empty()) return true;
+  size_t start = 0;
+  while (start <= filter.size()) {
+    const size_t end = std::min(filter.find('|', start), filter.size());
+    if (end > start && name.find(filter.substr(start, end - start)) != std::string::npos) return true;
+    start = end + 1;
+  }
+  return false;
+}
+
+bool SameExtraction(const EcvOptions& a, const EcvOptions& b) {
+  return a.monogenic.wavelength_px == b.monogenic.wavelength_px && a.grid_spacing_px == b.grid_spacing_px &&
+         a.min_magnitude == b.min_magnitude && a.max_edge_variance == b.max_edge_variance && a.edge_nms == b.edge_nms;
+}
+
+// Mean ECV score of each variant per set, on the tuning pairs (videos 0000, 0001) and the held-out ones.
+std::string AblationTable(const std::vector<ViewPair>& pairs, const std::vector<PairPrimitives>& default_primitives,
+                          const std::string& filter) {
+  const std::vector<std::string> sets = {"recognition", "hard", "easy"};
+  std::string table =
+      "### Ablations of the ECV context descriptor (mean score %, tuning = videos 0000 and 0001, held out = 0002)\n\n"
+      "| variant | recognition tuning | recognition held out | hard (held out) | easy tuning | easy held out |\n"
+      "|---|---:|---:|---:|---:|---:|\n";
+  for (const Variant& variant : Variants()) {
+    if (!MatchesFilter(variant.name, filter)) continue;
+    std::map<std::string, std::pair<double, int>> sums;  // key: set + tuning/held-out
+    for (size_t i = 0; i < pairs.size(); ++i) {
+      const PairPrimitives primitives = SameExtraction(variant.extraction, EcvOptions{})
+                                            ? default_primitives[i]
+                                            : Extract(pairs[i], variant.extraction);
+      const double score = ScoreEcv(pairs[i], primitives, variant.descriptor, variant.matching).score;
+      auto& [sum, count] = sums[pairs[i].set + (pairs[i].held_out ? "/held" : "/tune")];
+      sum += score;
+      ++count;
+    }
+    auto mean = [&](const std::string& key) {
+      const auto found = sums.find(key);
+      return found == sums.end() ? std::string("") : Percent(found->second.first / found->second.second);
+    };
+    table += "| " + variant.name + " | " + mean("recognition/tune") + " | " + mean("recognition/held") + " | " +
+             mean("hard/held") + " | " + mean("easy/tune") + " | " + mean("easy/held") + " |\n";
+    std::cerr << '.' << std::flush;
+  }
+  return table + "\n";
+}
+
 }  // namespace
 }  // namespace ecv::bench
 
@@ -196,23 +371,38 @@ int main(int argc, char** argv) {
   using namespace ecv::bench;
   std::string results = std::string(ECV_SOURCE_DIR) + "/bench/RESULTS.md";
   std::string figures = std::string(ECV_SOURCE_DIR) + "/bench/figures";
-  for (int i = 1; i + 1 < argc; i += 2) {
-    if (std::strcmp(argv[i], "--results") == 0) results = argv[i + 1];
-    if (std::strcmp(argv[i], "--figures") == 0) figures = argv[i + 1];
+  bool ablations_only = false;
+  std::string variant_filter;     // only ablation variants whose name contains one of its '|'-separated parts
+  double library_distance_m = 0;  // 0: library views as close as the object fits the image
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--ablations-only") == 0) ablations_only = true;
+    if (i + 1 < argc && std::strcmp(argv[i], "--results") == 0) results = argv[i + 1];
+    if (i + 1 < argc && std::strcmp(argv[i], "--figures") == 0) figures = argv[i + 1];
+    if (i + 1 < argc && std::strcmp(argv[i], "--variants") == 0) variant_filter = argv[i + 1];
+    if (i + 1 < argc && std::strcmp(argv[i], "--library-distance") == 0) library_distance_m = std::atof(argv[i + 1]);
   }
   std::cerr << "rendering and loading view pairs...\n";
-  const std::vector<ecv::bench::ViewPair> pairs = LoadViewPairs(ECV_DATA_DIR);
+  const std::vector<ecv::bench::ViewPair> pairs = LoadViewPairs(ECV_DATA_DIR, library_distance_m);
   const auto methods = Methods();
   std::vector<std::string> names;
   for (const auto& [name, method] : methods) names.push_back(name);
 
   std::vector<std::vector<PairScore>> scores(pairs.size());
+  std::vector<PairPrimitives> primitives;
   for (size_t i = 0; i < pairs.size(); ++i) {
-    const PairPrimitives primitives = Extract(pairs[i], {});
-    for (const auto& [name, method] : methods) scores[i].push_back(method(pairs[i], primitives));
+    primitives.push_back(Extract(pairs[i], {}));
+    if (!ablations_only) {
+      for (const auto& [name, method] : methods) scores[i].push_back(method(pairs[i], primitives.back()));
+    }
     std::cerr << "\rpair " << i + 1 << "/" << pairs.size() << std::flush;
   }
   std::cerr << '\n';
+  const std::string ablations = AblationTable(pairs, primitives, variant_filter);
+  std::cerr << '\n';
+  if (ablations_only) {
+    std::cout << ablations;
+    return 0;
+  }
   std::string report =
       "Correspondence score (paper Sect. IV-A): % of nearest-neighbour matches whose points lie within 1 cm after "
       "ground-truth alignment, mean per object, on real YCB-Video frames. Peers run at the ECV keypoints (\"@ECV\", "
@@ -220,6 +410,17 @@ int main(int argc, char** argv) {
       "OpenCV (no xfeatures2d), so it is absent. random = expected score of matching at random; ceiling = share of "
       "query keypoints with any true partner within 1 cm.\n\n";
   for (const std::string set : {"recognition", "hard", "easy"}) report += SetTable(set, pairs, names, scores);
+  report += ablations;
+  report += "![bar chart](figures/descriptor_scores.png)\n\n![matches](figures/descriptor_matches.jpg)\n\n";
+  cv::imwrite(figures + "/descriptor_scores.png", BarChart(pairs, names, scores));
+  for (size_t i = 0; i < pairs.size(); ++i) {  // a recognition pair of the cracker box
+    if (pairs[i].set == "recognition" && pairs[i].object == "003_cracker_box") {
+      cv::Mat picture = MatchPicture(pairs[i], primitives[i]);
+      cv::resize(picture, picture, cv::Size(), 0.75, 0.75, cv::INTER_AREA);
+      cv::imwrite(figures + "/descriptor_matches.jpg", picture, {cv::IMWRITE_JPEG_QUALITY, 85});
+      break;
+    }
+  }
   Report(results, "Discriminative power of descriptors (paper Fig. 7)", CommandLine(argc, argv), report);
   return 0;
 }

@@ -50,7 +50,7 @@ std::map<std::string, ObjectView> RealViews(const std::string& data, const std::
 // Renders the textured meshes; the library is `kLibraryViews` views over the sphere.
 class MeshViews {
  public:
-  MeshViews(const std::string& data, const PinholeCamera& camera) : camera_(camera) {
+  MeshViews(const std::string& data, const PinholeCamera& camera, double library_distance_m) : camera_(camera) {
     for (const char* object : kTextured) {
       MeshLoadOptions options;
       options.object_from_mesh = Google16kToYcbv(data, object);
@@ -60,6 +60,7 @@ class MeshViews {
       spheres_[object] = ComputeBoundingSphere(mesh);
       ViewSamplingOptions sampling;
       sampling.num_views = kLibraryViews;
+      sampling.distance_m = library_distance_m;
       library_[object] = SampleViews(spheres_[object], camera_, sampling);
     }
   }
@@ -111,10 +112,10 @@ class MeshViews {
 
 }  // namespace
 
-std::vector<ViewPair> LoadViewPairs(const std::string& data) {
+std::vector<ViewPair> LoadViewPairs(const std::string& data, double library_distance_m) {
   std::vector<ViewPair> pairs;
   const PinholeCamera camera = LoadYcbvFrame(FramePrefix(data, "0001", 1)).rgbd.camera;
-  MeshViews meshes(data, camera);
+  MeshViews meshes(data, camera, library_distance_m);
   for (const std::string video : {"0000", "0001", "0002"}) {
     const bool held_out = video == "0002";
     const std::map<std::string, ObjectView> first = RealViews(data, video, 1), last = RealViews(data, video, 19);

@@ -28,7 +28,8 @@ struct ViewPair {
   Eigen::Isometry3d TrainFromQuery() const { return train.camera_from_object * query.camera_from_object.inverse(); }
 };
 
-/// The pairs of the three sets on the YCB-Video frames under `data_dir` (renders with OSMesa).
-std::vector<ViewPair> LoadViewPairs(const std::string& data_dir);
+/// The pairs of the three sets on the YCB-Video frames under `data_dir` (renders with OSMesa). The library
+/// views are rendered `library_distance_m` from the object centre (0: as close as fits the image).
+std::vector<ViewPair> LoadViewPairs(const std::string& data_dir, double library_distance_m = 0.0);
 
 }  // namespace ecv::bench

@@ -5,6 +5,7 @@
 
 #include <cstring>
 #include <iostream>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -12,8 +13,11 @@
 #include <opencv2/imgproc.hpp>
 
 #include "bench_util.h"
+#include "ecv/descriptor.h"
+#include "ecv/matching.h"
 #include "ecv/primitives.h"
 #include "io/frame_io.h"
+#include "peer_descriptors.h"
 
 namespace {
 
@@ -23,6 +27,7 @@ using ecv::bench::Median;
 
 struct Timings {
   std::vector<double> monogenic, grid, classify, reconstruct, total, sift, orb, segments, texlets, sift_count;
+  std::vector<double> describe, index, match, fpfh;
 };
 
 // The best of `runs` extractions of one frame (the machine is shared: the minimum is the least noisy).
@@ -59,12 +64,26 @@ void MeasureFrame(const ecv::RgbdFrame& frame, int runs, Timings* timings) {
   cv::Mat grey;
   cv::cvtColor(frame.color, grey, cv::COLOR_RGB2GRAY);
   std::vector<cv::KeyPoint> keypoints;
-  cv::Mat descriptors;
   const cv::Ptr<cv::SIFT> sift = cv::SIFT::create();
   timings->sift.push_back(BestMilliseconds(runs, [&] { sift->detect(grey, keypoints); }));
   timings->sift_count.push_back(static_cast<double>(keypoints.size()));
   const cv::Ptr<cv::ORB> orb = cv::ORB::create(2000);
   timings->orb.push_back(BestMilliseconds(runs, [&] { orb->detect(grey, keypoints); }));
+
+  // Context descriptors of the whole frame, an index over them, and matching the frame against itself.
+  ecv::Descriptors descriptors;  // ECV context descriptors
+  timings->describe.push_back(
+      BestMilliseconds(runs, [&] { descriptors = ecv::ComputeDescriptors(result.primitives); }));
+  std::unique_ptr<ecv::DescriptorMatcher> matcher;
+  timings->index.push_back(BestMilliseconds(
+      runs, [&] { matcher = std::make_unique<ecv::DescriptorMatcher>(result.primitives, descriptors); }));
+  timings->match.push_back(BestMilliseconds(runs, [&] { matcher->Match(result.primitives, descriptors); }));
+  // Peer: PCL's FPFH at the same keypoints (support voxelised at 4 mm, radius 0.025 m), one run.
+  std::vector<Eigen::Vector3f> positions;
+  for (const ecv::Primitive& p : result.primitives) positions.push_back(p.position);
+  timings->fpfh.push_back(BestMilliseconds(1, [&] {
+    ecv::bench::ComputePclDescriptors(frame, cv::Mat(), positions, ecv::bench::PclDescriptor::kFpfh, 0.025);
+  }));
 }
 
 std::string Row(const char* name, const std::vector<double>& values, double reference) {
@@ -105,6 +124,10 @@ int main(int argc, char** argv) {
   table += Row("**ECV extraction, total**", timings.total, total);
   table += Row("peer: OpenCV SIFT detector", timings.sift, total);
   table += Row("peer: OpenCV ORB detector (2000 features)", timings.orb, total);
+  table += Row("ECV context descriptors, whole frame", timings.describe, total);
+  table += Row("FLANN index over them (per type)", timings.index, total);
+  table += Row("matching the frame against itself (1-NN)", timings.match, total);
+  table += Row("peer: PCL FPFH at the same keypoints (incl. normals)", timings.fpfh, total);
   table += "\nPrimitives per frame (median): " + Fixed(Median(timings.segments), 0) + " segments, " +
            Fixed(Median(timings.texlets), 0) + " texlets; SIFT keypoints: " + Fixed(Median(timings.sift_count), 0) +
            ".\n";

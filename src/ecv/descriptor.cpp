@@ -17,7 +17,7 @@ namespace {
 void AddToHistogram(float value, float low, bool soft, float* histogram) {
   const float position = (value - low) / (1.0F - low) * kDescriptorBins - 0.5F;  // bin centres at integers
   if (!soft) {
-    const int bin = std::clamp(static_cast<int>(std::lround(position)), 0, kDescriptorBins - 1);
+    const int bin = std::clamp(static_cast<int>(position + 0.5F), 0, kDescriptorBins - 1);  // position >= -0.5
     histogram[bin] += 1.0F;
     return;
   }
@@ -26,6 +26,16 @@ void AddToHistogram(float value, float low, bool soft, float* histogram) {
   const float upper_share = clamped - static_cast<float>(lower);
   histogram[lower] += 1.0F - upper_share;
   histogram[lower + 1] += upper_share;
+}
+
+// Colours scaled per channel so that their mean is 0.5 (grey world), clamped to [0, 1].
+std::vector<Primitive> BalanceColors(std::vector<Primitive> primitives) {
+  Eigen::Vector3f mean = Eigen::Vector3f::Zero();
+  for (const Primitive& p : primitives) mean += p.color;
+  mean /= static_cast<float>(primitives.size());
+  const Eigen::Vector3f gain = (0.5F * mean.cwiseMax(1e-3F).cwiseInverse()).cwiseMin(8.0F);
+  for (Primitive& p : primitives) p.color = p.color.cwiseProduct(gain).cwiseMin(1.0F);
+  return primitives;
 }
 
 // Histograms of the pairs of `neighbours` (indices into primitives, sorted by distance to the source).
@@ -66,13 +76,19 @@ void DescribeContext(const std::vector<Primitive>& primitives, const std::vector
 }  // namespace
 
 void DescriptorOptions::Check() const {
+  if (max_neighbours < 0 || max_neighbours == 1) {
+    ThrowInputError("descriptor options", "max_neighbours", "0 (all) or at least 2", std::to_string(max_neighbours));
+  }
   if (!(radius_m > 0.0) || !std::isfinite(radius_m)) {
     ThrowInputError("descriptor options", "radius_m", "a radius > 0 m", std::to_string(radius_m));
   }
 }
 
-Descriptors ComputeDescriptors(const std::vector<Primitive>& primitives, const DescriptorOptions& options) {
+Descriptors ComputeDescriptors(const std::vector<Primitive>& input, const DescriptorOptions& options) {
   options.Check();
+  const std::vector<Primitive> balanced =
+      options.balance_colors && !input.empty() ? BalanceColors(input) : std::vector<Primitive>();
+  const std::vector<Primitive>& primitives = options.balance_colors ? balanced : input;
   Descriptors descriptors;
   descriptors.values.create(0, kDescriptorSize, CV_32F);
   if (primitives.size() < 2) return descriptors;
@@ -95,7 +111,10 @@ Descriptors ComputeDescriptors(const std::vector<Primitive>& primitives, const D
   std::vector<int> neighbours;
   for (size_t i = 0; i < primitives.size(); ++i) {
     if (neighbour_lists[i].size() < 2) continue;  // isolated: no context
-    neighbours.assign(neighbour_lists[i].begin(), neighbour_lists[i].end());
+    const size_t kept = options.max_neighbours > 0
+                            ? std::min<size_t>(neighbour_lists[i].size(), static_cast<size_t>(options.max_neighbours))
+                            : neighbour_lists[i].size();
+    neighbours.assign(neighbour_lists[i].begin(), neighbour_lists[i].begin() + static_cast<long>(kept));
     float* row = values.ptr<float>(static_cast<int>(descriptors.primitive.size()));
     DescribeContext(primitives, neighbours, options, row);
     descriptors.primitive.push_back(static_cast<int>(i));

@@ -12,13 +12,21 @@ namespace ecv {
 inline constexpr int kDescriptorBins = 16;
 inline constexpr int kDescriptorSize = 6 * kDescriptorBins;
 
-/// The ECV context descriptor (paper Sect. II-B; DESIGN.md "Context descriptor").
+/// The ECV context descriptor (paper Sect. II-B; DESIGN.md "Context descriptor"). Defaults chosen by the
+/// correspondence score on YCB-Video videos 0000 and 0001 (bench/RESULTS.md, ablations); the paper's own
+/// descriptor is soft_binning = false, hellinger = false.
 struct DescriptorOptions {
-  double radius_m = 0.025;         ///< context radius around each primitive, metres
+  double radius_m = 0.025;  ///< context radius around each primitive, metres
+  /// Context = at most this many primitives nearest to the source (itself included); 0 = all within
+  /// the radius, as in the paper. Pairs grow with its square: the cap bounds the cost in dense views.
+  int max_neighbours = 0;
   bool unsigned_segments = false;  ///< a segment's direction has no sign: use |cosines| that involve one
-  bool soft_binning = false;       ///< share each value between its two nearest bins (linear)
+  bool soft_binning = true;        ///< share each value between its two nearest bins (linear)
   bool use_color = true;           ///< false: shape only (the three colour histograms stay zero)
-  bool hellinger = false;          ///< store square roots of the histogram values (L2 then = Hellinger)
+  /// Grey-world balance before the colour differences: each channel scaled so that the mean over the
+  /// primitives is 0.5 (beyond the paper: cancels white balance and exposure between views).
+  bool balance_colors = false;
+  bool hellinger = true;  ///< store square roots of the histogram values (L2 then = Hellinger)
 
   void Check() const;
 };

@@ -13,7 +13,7 @@ namespace ecv {
 struct MatchOptions {
   int k = 1;                       ///< neighbours returned per query descriptor
   bool structure_specific = true;  ///< segments only against segments, texlets only against texlets
-  int exact_below = 4000;          ///< a train set smaller than this is searched exactly (linear scan)
+  int exact_below = 1000;          ///< a train set smaller than this is searched exactly (linear scan)
   int trees = 4;                   ///< randomised kd-trees of the approximate index
   int checks = 128;                ///< leaves visited per query by the approximate search
 

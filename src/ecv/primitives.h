@@ -28,10 +28,11 @@ struct Primitive {
   float image_orientation = 0.0F;                   ///< monogenic orientation at the keypoint, radians in [0, pi)
 };
 
-/// Options of the ECV extraction; the defaults were chosen by the correspondence score (bench/).
+/// Options of the ECV extraction; defaults chosen by the correspondence score of the context descriptor on
+/// YCB-Video videos 0000 and 0001 (bench/discriminative_bench, ablations in bench/RESULTS.md).
 struct EcvOptions {
   MonogenicOptions monogenic;
-  double grid_spacing_px = 7.0;     ///< distance between hexagonal cell centres, pixels
+  double grid_spacing_px = 5.0;     ///< distance between hexagonal cell centres, pixels
   double min_magnitude = 0.02;      ///< cells whose largest magnitude is below are homogeneous (grey in [0, 1])
   double max_edge_variance = 0.25;  ///< circular variance of 2 theta (magnitude-weighted) below: edge, above: texture
   bool edge_nms = true;             ///< drop edge cells whose keypoint is not a magnitude maximum across the edge

@@ -49,6 +49,7 @@ TEST(EcvDescriptor, InvariantToRigidMotionAndNormalised) {
   for (const bool soft : {false, true}) {
     DescriptorOptions options;
     options.soft_binning = soft;
+    options.hellinger = !soft;  // both forms of each option once
     const Descriptors original = ComputeDescriptors(primitives, options);
     const Descriptors moved = ComputeDescriptors(Moved(primitives, SomeRigidMotion()), options);
     ASSERT_EQ(original.primitive, moved.primitive);
@@ -59,7 +60,9 @@ TEST(EcvDescriptor, InvariantToRigidMotionAndNormalised) {
     for (int row = 0; row < original.values.rows; ++row) {
       for (int h = 0; h < 6; ++h) {
         const cv::Mat histogram = original.values.row(row).colRange(h * kDescriptorBins, (h + 1) * kDescriptorBins);
-        ASSERT_NEAR(cv::sum(histogram)[0], 1.0, 1e-5) << "row " << row << " histogram " << h;
+        // Each histogram sums to 1; stored as square roots (Hellinger), their squares do.
+        const double sum = options.hellinger ? histogram.dot(histogram) : cv::sum(histogram)[0];
+        ASSERT_NEAR(sum, 1.0, 1e-5) << "row " << row << " histogram " << h;
       }
     }
   }
