@@ -5,7 +5,7 @@
 // a picture of matches. Writes to bench/RESULTS.md and bench/figures/.
 //
 //   discriminative_bench [--results FILE] [--figures DIR] [--ablations-only] [--variants TEXT]
-//                        [--library-distance M]
+//                        [--library-distance M] [--headlight]
 
 #include <algorithm>
 #include <cstdlib>
@@ -374,15 +374,17 @@ int main(int argc, char** argv) {
   bool ablations_only = false;
   std::string variant_filter;     // only ablation variants whose name contains one of its '|'-separated parts
   double library_distance_m = 0;  // 0: library views as close as the object fits the image
+  ecv::Shading shading = ecv::Shading::kUnlit;  // of the library renders
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--ablations-only") == 0) ablations_only = true;
     if (i + 1 < argc && std::strcmp(argv[i], "--results") == 0) results = argv[i + 1];
     if (i + 1 < argc && std::strcmp(argv[i], "--figures") == 0) figures = argv[i + 1];
     if (i + 1 < argc && std::strcmp(argv[i], "--variants") == 0) variant_filter = argv[i + 1];
     if (i + 1 < argc && std::strcmp(argv[i], "--library-distance") == 0) library_distance_m = std::atof(argv[i + 1]);
+    if (std::strcmp(argv[i], "--headlight") == 0) shading = ecv::Shading::kHeadlight;
   }
   std::cerr << "rendering and loading view pairs...\n";
-  const std::vector<ecv::bench::ViewPair> pairs = LoadViewPairs(ECV_DATA_DIR, library_distance_m);
+  const std::vector<ecv::bench::ViewPair> pairs = LoadViewPairs(ECV_DATA_DIR, library_distance_m, shading);
   const auto methods = Methods();
   std::vector<std::string> names;
   for (const auto& [name, method] : methods) names.push_back(name);

@@ -50,7 +50,9 @@ std::map<std::string, ObjectView> RealViews(const std::string& data, const std::
 // Renders the textured meshes; the library is `kLibraryViews` views over the sphere.
 class MeshViews {
  public:
-  MeshViews(const std::string& data, const PinholeCamera& camera, double library_distance_m) : camera_(camera) {
+  MeshViews(const std::string& data, const PinholeCamera& camera, double library_distance_m, Shading shading)
+      : camera_(camera) {
+    render_options_.shading = shading;
     for (const char* object : kTextured) {
       MeshLoadOptions options;
       options.object_from_mesh = Google16kToYcbv(data, object);
@@ -68,7 +70,7 @@ class MeshViews {
   bool Has(const std::string& object) const { return meshes_.count(object) > 0; }
 
   ObjectView Render(const std::string& object, const Eigen::Isometry3d& camera_from_object, const std::string& name) {
-    const RenderResult rendered = renderer_.Render(meshes_.at(object), camera_, camera_from_object);
+    const RenderResult rendered = renderer_.Render(meshes_.at(object), camera_, camera_from_object, render_options_);
     ObjectView view{name, {rendered.color, rendered.depth, camera_, name}, rendered.mask, camera_from_object};
     return view;
   }
@@ -104,6 +106,7 @@ class MeshViews {
 
  private:
   PinholeCamera camera_;
+  RenderOptions render_options_;
   Renderer renderer_;
   std::map<std::string, MeshId> meshes_;
   std::map<std::string, BoundingSphere> spheres_;
@@ -112,10 +115,10 @@ class MeshViews {
 
 }  // namespace
 
-std::vector<ViewPair> LoadViewPairs(const std::string& data, double library_distance_m) {
+std::vector<ViewPair> LoadViewPairs(const std::string& data, double library_distance_m, Shading shading) {
   std::vector<ViewPair> pairs;
   const PinholeCamera camera = LoadYcbvFrame(FramePrefix(data, "0001", 1)).rgbd.camera;
-  MeshViews meshes(data, camera, library_distance_m);
+  MeshViews meshes(data, camera, library_distance_m, shading);
   for (const std::string video : {"0000", "0001", "0002"}) {
     const bool held_out = video == "0002";
     const std::map<std::string, ObjectView> first = RealViews(data, video, 1), last = RealViews(data, video, 19);

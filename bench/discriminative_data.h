@@ -7,6 +7,7 @@
 
 #include "core/frame.h"
 #include "ecv/primitives.h"
+#include "render/renderer.h"
 
 namespace ecv::bench {
 
@@ -29,7 +30,9 @@ struct ViewPair {
 };
 
 /// The pairs of the three sets on the YCB-Video frames under `data_dir` (renders with OSMesa). The library
-/// views are rendered `library_distance_m` from the object centre (0: as close as fits the image).
-std::vector<ViewPair> LoadViewPairs(const std::string& data_dir, double library_distance_m = 0.0);
+/// views are rendered `library_distance_m` from the object centre (0: as close as fits the image) with
+/// `shading`.
+std::vector<ViewPair> LoadViewPairs(const std::string& data_dir, double library_distance_m = 0.0,
+                                    Shading shading = Shading::kUnlit);
 
 }  // namespace ecv::bench
