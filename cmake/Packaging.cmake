@@ -9,7 +9,7 @@ install(TARGETS ${ecv_libraries} ecvpose
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
 
 # Public headers keep their folder: include/ecvpose/core/camera.h, include/ecvpose/render/...
-install(DIRECTORY src/core src/ecv src/io DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/ecvpose FILES_MATCHING PATTERN "*.h")
+install(DIRECTORY src/core src/ecv src/io src/registration DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/ecvpose FILES_MATCHING PATTERN "*.h")
 foreach(stage render colorcal modeldb recognize)
   install(DIRECTORY ${stage} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/ecvpose FILES_MATCHING PATTERN "*.h")
 endforeach()
