@@ -7,9 +7,9 @@
 #include <random>
 #include <string>
 
-#include <Eigen/Geometry>
 #include <flann/algorithms/dist.h>
 #include <flann/algorithms/kdtree_single_index.h>
+#include <Eigen/Geometry>
 
 #include "core/error.h"
 
@@ -19,7 +19,8 @@ namespace {
 using KdTree = flann::KDTreeSingleIndex<flann::L2_Simple<float>>;
 
 // Rigid motion (Kabsch/Umeyama, no scale) taking `from` onto `to`; false when degenerate.
-bool FitRigid(const std::vector<Eigen::Vector3f>& from, const std::vector<Eigen::Vector3f>& to, Eigen::Isometry3d* result) {
+bool FitRigid(const std::vector<Eigen::Vector3f>& from, const std::vector<Eigen::Vector3f>& to,
+              Eigen::Isometry3d* result) {
   Eigen::Matrix3Xd a(3, from.size()), b(3, to.size());
   for (size_t i = 0; i < from.size(); ++i) {
     a.col(static_cast<long>(i)) = from[i].cast<double>();

@@ -16,15 +16,15 @@ struct Correspondence {
 /// The paper's RANSAC (Sect. III). With polygon_threshold > 0 it is the prerejective variant: a sample
 /// whose polygon edge lengths disagree is dropped before any pose is computed.
 struct RansacOptions {
-  int sample_size = 3;                  ///< n, correspondences per sample (>= 3)
-  double polygon_threshold = 0.25;      ///< t_poly on max_i |d_p,i - d_q,i| / max(d_p,i, d_q,i); <= 0: standard RANSAC
-  double inlier_threshold_m = 0.01;     ///< eps: an object point is an inlier within this of a scene point, metres
+  int sample_size = 3;               ///< n, correspondences per sample (>= 3)
+  double polygon_threshold = 0.25;   ///< t_poly on max_i |d_p,i - d_q,i| / max(d_p,i, d_q,i); <= 0: standard RANSAC
+  double inlier_threshold_m = 0.01;  ///< eps: an object point is an inlier within this of a scene point, metres
   double required_inlier_fraction = 0.5;  ///< of the object points (0.1 for scene registration)
-  double success_probability = 0.99;    ///< p
-  double expected_inlier_ratio = 0.05;  ///< w, of the correspondences
-  int max_iterations = 0;               ///< 0: k = log(1 - p) / log(1 - w^n), about 37 000 by default
-  double early_stop_fit_error_m = 0.0;  ///< > 0: stop once an accepted pose fits better than this, metres
-  uint64_t seed = 1;                    ///< same seed, same result
+  double success_probability = 0.99;      ///< p
+  double expected_inlier_ratio = 0.05;    ///< w, of the correspondences
+  int max_iterations = 0;                 ///< 0: k = log(1 - p) / log(1 - w^n), about 37 000 by default
+  double early_stop_fit_error_m = 0.0;    ///< > 0: stop once an accepted pose fits better than this, metres
+  uint64_t seed = 1;                      ///< same seed, same result
 
   /// Throws InputError on values outside their ranges.
   void Check() const;
@@ -37,10 +37,10 @@ struct RansacOptions {
 struct RansacResult {
   bool success = false;
   Eigen::Isometry3d scene_from_object = Eigen::Isometry3d::Identity();  ///< camera_from_object for a scene frame
-  double inlier_fraction = 0.0;  ///< of the object points
-  double fit_error_m = 0.0;      ///< mean distance of the inliers to their nearest scene points, metres
-  int iterations = 0;            ///< samples drawn
-  int rejected_by_polygon = 0;   ///< samples the polygon test dropped before a pose was computed
+  double inlier_fraction = 0.0;                                         ///< of the object points
+  double fit_error_m = 0.0;     ///< mean distance of the inliers to their nearest scene points, metres
+  int iterations = 0;           ///< samples drawn
+  int rejected_by_polygon = 0;  ///< samples the polygon test dropped before a pose was computed
   double time_ms = 0.0;
 };
 
@@ -49,7 +49,8 @@ struct RansacResult {
 class PolygonEdgeCheck {
  public:
   explicit PolygonEdgeCheck(double threshold) : threshold_(threshold) {}
-  bool operator()(const std::vector<Eigen::Vector3f>& object_sample, const std::vector<Eigen::Vector3f>& scene_sample) const;
+  bool operator()(const std::vector<Eigen::Vector3f>& object_sample,
+                  const std::vector<Eigen::Vector3f>& scene_sample) const;
 
  private:
   double threshold_;

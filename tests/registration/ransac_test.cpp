@@ -26,12 +26,14 @@ Problem MakeProblem(int points, int true_count, int total, double noise_m, unsig
   std::normal_distribution<float> noise(0.0F, static_cast<float>(noise_m));
   Problem problem;
   problem.scene_from_object = Eigen::Isometry3d::Identity();
-  problem.scene_from_object.linear() = Eigen::AngleAxisd(2.0, Eigen::Vector3d(1, -2, 0.5).normalized()).toRotationMatrix();
+  problem.scene_from_object.linear() =
+      Eigen::AngleAxisd(2.0, Eigen::Vector3d(1, -2, 0.5).normalized()).toRotationMatrix();
   problem.scene_from_object.translation() = Eigen::Vector3d(0.1, -0.05, 0.9);
   const Eigen::Isometry3f transform = problem.scene_from_object.cast<float>();
   for (int i = 0; i < points; ++i) {
     problem.object.emplace_back(unit(random), unit(random), unit(random));
-    problem.scene.push_back(transform * problem.object.back() + Eigen::Vector3f(noise(random), noise(random), noise(random)));
+    problem.scene.push_back(transform * problem.object.back() +
+                            Eigen::Vector3f(noise(random), noise(random), noise(random)));
   }
   std::uniform_int_distribution<int> any(0, points - 1);
   for (int i = 0; i < total; ++i) {
@@ -80,13 +82,15 @@ TEST(Ransac, PolygonTestKeepsTrueSamplesAndRejectsRandomOnes) {
   for (int trial = 0; trial < 20000; ++trial) {
     const int a = any(random), b = any(random), c = any(random);
     const std::vector<Eigen::Vector3f> object = {problem.object[a], problem.object[b], problem.object[c]};
-    const float shortest = std::min({(object[0] - object[1]).norm(), (object[1] - object[2]).norm(), (object[2] - object[0]).norm()});
+    const float shortest =
+        std::min({(object[0] - object[1]).norm(), (object[1] - object[2]).norm(), (object[2] - object[0]).norm()});
     if (shortest >= 0.03F) {  // true correspondences with edges of at least 3 cm: never rejected
       ++true_samples;
       ASSERT_TRUE(check(object, {problem.scene[a], problem.scene[b], problem.scene[c]})) << trial;
     }
     ++random_samples;
-    random_rejected += check(object, {problem.scene[any(random)], problem.scene[any(random)], problem.scene[any(random)]}) ? 0 : 1;
+    random_rejected +=
+        check(object, {problem.scene[any(random)], problem.scene[any(random)], problem.scene[any(random)]}) ? 0 : 1;
   }
   EXPECT_GT(true_samples, 5000);
   EXPECT_GT(random_rejected, 0.7 * random_samples);
