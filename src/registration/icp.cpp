@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/Dense>
 #include <flann/algorithms/dist.h>
 #include <flann/algorithms/kdtree_single_index.h>
+#include <Eigen/Dense>
 
 #include "core/error.h"
 
@@ -81,7 +81,8 @@ IcpResult RefinePointToPlane(const std::vector<Eigen::Vector3f>& object_points,
     const Eigen::Isometry3f transform = result.scene_from_object.cast<float>();
     for (const Eigen::Vector3f& point : object_points) {
       Eigen::Vector3f moved = transform * point;
-      tree.knnSearch(flann::Matrix<float>(moved.data(), 1, 3), index_matrix, squared_matrix, 1, flann::SearchParams(-1));
+      tree.knnSearch(flann::Matrix<float>(moved.data(), 1, 3), index_matrix, squared_matrix, 1,
+                     flann::SearchParams(-1));
       if (squared > max_squared) continue;
       const Eigen::Vector3d n = normals[index].cast<double>(), p = moved.cast<double>();
       const double residual = (p - scene_points[index].cast<double>()).dot(n);
@@ -99,7 +100,8 @@ IcpResult RefinePointToPlane(const std::vector<Eigen::Vector3f>& object_points,
     if (!step.allFinite()) return result;
     result.scene_from_object = Increment(step) * result.scene_from_object;
     result.success = true;
-    if (step.head<3>().norm() < options.convergence_rotation_rad && step.tail<3>().norm() < options.convergence_translation_m) {
+    if (step.head<3>().norm() < options.convergence_rotation_rad &&
+        step.tail<3>().norm() < options.convergence_translation_m) {
       break;
     }
   }

@@ -8,11 +8,11 @@ namespace ecv {
 
 /// Point-to-plane ICP that refines an accepted pose against dense scene points.
 struct IcpOptions {
-  int max_iterations = 30;                   ///< Gauss-Newton steps at most
-  double max_correspondence_m = 0.01;        ///< object points farther than this from the scene are ignored, metres
-  double convergence_translation_m = 1e-5;   ///< stop when a step moves less than this, metres ...
-  double convergence_rotation_rad = 1e-5;    ///< ... and turns less than this, radians
-  int normal_neighbours = 10;                ///< scene normals from this many nearest points (PCA)
+  int max_iterations = 30;                  ///< Gauss-Newton steps at most
+  double max_correspondence_m = 0.01;       ///< object points farther than this from the scene are ignored, metres
+  double convergence_translation_m = 1e-5;  ///< stop when a step moves less than this, metres ...
+  double convergence_rotation_rad = 1e-5;   ///< ... and turns less than this, radians
+  int normal_neighbours = 10;               ///< scene normals from this many nearest points (PCA)
 
   void Check() const;
 };

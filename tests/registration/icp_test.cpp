@@ -54,7 +54,8 @@ TEST(Icp, RefinesTheCrackerBoxTowardsTheRealGroundTruth) {
   for (int v = 0; v < mask.rows; ++v) {
     for (int u = 0; u < mask.cols; ++u) {
       const float z = loaded.rgbd.depth.at<float>(v, u);
-      if (mask.at<uchar>(v, u) != 0 && z > 0.0F) scene.push_back(loaded.rgbd.camera.BackProject(Eigen::Vector2d(u, v), z).cast<float>());
+      if (mask.at<uchar>(v, u) != 0 && z > 0.0F)
+        scene.push_back(loaded.rgbd.camera.BackProject(Eigen::Vector2d(u, v), z).cast<float>());
     }
   }
   const Eigen::Isometry3d truth = loaded.ground_truth.at(1).camera_from_object;
@@ -66,7 +67,8 @@ TEST(Icp, RefinesTheCrackerBoxTowardsTheRealGroundTruth) {
     const Eigen::Vector3d seen = initial * p;
     const Eigen::Vector2d pixel = loaded.rgbd.camera.Project(seen);
     if (!loaded.rgbd.camera.Contains(pixel)) continue;
-    const float z = loaded.rgbd.depth.at<float>(static_cast<int>(std::lround(pixel.y())), static_cast<int>(std::lround(pixel.x())));
+    const float z =
+        loaded.rgbd.depth.at<float>(static_cast<int>(std::lround(pixel.y())), static_cast<int>(std::lround(pixel.x())));
     if (z > 0.0F && std::abs(seen.z() - z) < 0.02) object.push_back(p.cast<float>());
   }
   ASSERT_GT(object.size(), 300U);
