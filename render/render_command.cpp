@@ -34,9 +34,7 @@ struct RenderArgs {
   std::string out_dir;
   int width = 640;
   int height = 480;
-  std::string unit = "m";
-  std::string object_from_mesh_path;
-  bool allow_missing_textures = false;
+  MeshArgs mesh;
   std::string shading = "unlit";
   std::vector<double> elevation_deg = {-90.0, 90.0};
   std::string up = "0,0,1";
@@ -66,19 +64,6 @@ class Progress {
 int UsageError(const std::string& message) {
   std::cerr << "ecvpose render: " << message << "\nRun `ecvpose render --help` for the forms of the command.\n";
   return kExitBadUsage;
-}
-
-TriangleMesh LoadMeshArgument(const std::string& path, const RenderArgs& args) {
-  MeshLoadOptions options;
-  options.metres_per_unit = MetresPerUnit(args.unit);
-  options.allow_missing_textures = args.allow_missing_textures;
-  if (!args.object_from_mesh_path.empty()) {
-    options.object_from_mesh = ReadPoseFile(args.object_from_mesh_path, "object_from_mesh");
-  }
-  std::vector<std::string> warnings;
-  TriangleMesh mesh = LoadMesh(path, options, &warnings);
-  for (const std::string& warning : warnings) std::cerr << "ecvpose: warning: " << warning << '\n';
-  return mesh;
 }
 
 // --camera fx,fy,cx,cy (the frame flag) with --width/--height; by default a 58 degree horizontal field of view (Kinect
@@ -137,7 +122,7 @@ std::string Stem(int index) {
 
 int RunViews(const RenderArgs& args) {
   const std::string& mesh_path = args.positionals.at(0);
-  const TriangleMesh mesh = LoadMeshArgument(mesh_path, args);
+  const TriangleMesh mesh = LoadMeshWithArgs(mesh_path, args.mesh);
   const PinholeCamera camera = CameraArgument(args);
   const std::vector<Eigen::Isometry3d> views =
       SampleViews(ComputeBoundingSphere(mesh), camera, SamplingArguments(args));
@@ -158,7 +143,7 @@ int RunViews(const RenderArgs& args) {
   if (out_of_range > 0)
     std::cerr << "ecvpose: warning: " << out_of_range << " depth pixels beyond 6.5535 m written as 0\n";
   WriteJsonFile(args.out_dir + "/views.json", {{"mesh", mesh_path},
-                                               {"unit", args.unit},
+                                               {"unit", args.mesh.unit},
                                                {"camera", CameraToJson(camera)},
                                                {"depth_scale", kRenderedDepthScale},
                                                {"renderer", renderer.Description()},
@@ -174,7 +159,7 @@ int RunOverlay(const RenderArgs& args) {
   const LoadedFrame frame = LoadFrame(spec);
   const Eigen::Isometry3d camera_from_object = ReadPoseFile(args.pose_path);
   Renderer renderer;
-  const MeshId id = renderer.AddMesh(LoadMeshArgument(args.positionals.at(0), args));
+  const MeshId id = renderer.AddMesh(LoadMeshWithArgs(args.positionals.at(0), args.mesh));
   WriteColorImage(args.overlay_path,
                   RenderOverlay(renderer, {SceneObject{id, camera_from_object}}, frame.rgbd.camera, frame.rgbd.color));
   std::cout << "wrote " << args.overlay_path << '\n';
@@ -258,12 +243,7 @@ CommandAction SetupRenderCommand(CLI::App& command) {
   command.add_option("--height", args->height, "Image height, pixels")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
-  command.add_option("--unit", args->unit, "Unit of mesh coordinates")
-      ->check(CLI::IsMember({"m", "cm", "mm"}))
-      ->capture_default_str();
-  command.add_option("--object-from-mesh", args->object_from_mesh_path, "Pose JSON, key object_from_mesh")
-      ->check(CLI::ExistingFile);
-  command.add_flag("--allow-missing-textures", args->allow_missing_textures, "Material colour for missing textures");
+  AddMeshFlags(command, &args->mesh);
   command.add_option("--shading", args->shading, "unlit (surface colours as stored) or headlight")
       ->check(CLI::IsMember({"unlit", "headlight"}))
       ->capture_default_str();

@@ -1,5 +1,11 @@
 #include "app/frame_args.h"
 
+#include <iostream>
+#include <vector>
+
+#include "io/mesh_io.h"
+#include "io/pose_io.h"
+
 namespace ecv::app {
 
 void AddFrameFlags(CLI::App& command, FrameSpec* spec) {
@@ -15,6 +21,35 @@ void AddFrameFlags(CLI::App& command, FrameSpec* spec) {
       .add_option_function<std::string>(
           "--camera", [spec](const std::string& text) { spec->camera = text; }, "Intrinsics fx,fy,cx,cy in pixels")
       ->group("Frame from files");
+}
+
+void AddMeshFlags(CLI::App& command, MeshArgs* args) {
+  command.add_option("--unit", args->unit, "Unit of mesh coordinates")
+      ->check(CLI::IsMember({"m", "cm", "mm"}))
+      ->capture_default_str()
+      ->group("Mesh");
+  command
+      .add_option("--object-from-mesh", args->object_from_mesh_path,
+                  "Pose JSON with key object_from_mesh applied to meshes after the unit")
+      ->check(CLI::ExistingFile)
+      ->group("Mesh");
+  command
+      .add_flag("--allow-missing-textures", args->allow_missing_textures,
+                "Use vertex or material colours where a texture file is missing (with a warning)")
+      ->group("Mesh");
+}
+
+TriangleMesh LoadMeshWithArgs(const std::string& path, const MeshArgs& args) {
+  MeshLoadOptions options;
+  options.metres_per_unit = MetresPerUnit(args.unit);
+  options.allow_missing_textures = args.allow_missing_textures;
+  if (!args.object_from_mesh_path.empty()) {
+    options.object_from_mesh = ReadPoseFile(args.object_from_mesh_path, "object_from_mesh");
+  }
+  std::vector<std::string> warnings;
+  TriangleMesh mesh = LoadMesh(path, options, &warnings);
+  for (const std::string& warning : warnings) std::cerr << "ecvpose: warning: " << warning << '\n';
+  return mesh;
 }
 
 }  // namespace ecv::app

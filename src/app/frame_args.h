@@ -2,6 +2,9 @@
 
 #include <CLI/CLI.hpp>
 
+#include <string>
+
+#include "core/mesh.h"
 #include "io/frame_io.h"
 
 namespace ecv::app {
@@ -9,5 +12,18 @@ namespace ecv::app {
 /// Declares the frame flags shared by every subcommand (--color, --depth, --depth-scale, --camera) on
 /// `command`; parsed values land in `spec`. The positional FRAME is declared by each command.
 void AddFrameFlags(CLI::App& command, FrameSpec* spec);
+
+/// The mesh flags shared by every subcommand that reads meshes.
+struct MeshArgs {
+  std::string unit = "m";               ///< --unit m|cm|mm
+  std::string object_from_mesh_path;    ///< --object-from-mesh POSE.json
+  bool allow_missing_textures = false;  ///< --allow-missing-textures
+};
+
+/// Declares --unit, --object-from-mesh and --allow-missing-textures on `command`.
+void AddMeshFlags(CLI::App& command, MeshArgs* args);
+
+/// Loads the mesh at `path` as the flags say; what was tolerated is printed as a warning.
+TriangleMesh LoadMeshWithArgs(const std::string& path, const MeshArgs& args);
 
 }  // namespace ecv::app

@@ -18,9 +18,7 @@ namespace {
 struct InfoArgs {
   std::vector<std::string> paths;
   FrameSpec frame;
-  std::string unit = "m";
-  std::string object_from_mesh_path;
-  bool allow_missing_textures = false;
+  MeshArgs mesh;
   std::string out_json;
 };
 
@@ -69,15 +67,7 @@ nlohmann::json DescribeFrame(const LoadedFrame& loaded) {
 }
 
 nlohmann::json DescribeMesh(const std::string& path, const InfoArgs& args) {
-  MeshLoadOptions options;
-  options.metres_per_unit = MetresPerUnit(args.unit);
-  options.allow_missing_textures = args.allow_missing_textures;
-  if (!args.object_from_mesh_path.empty()) {
-    options.object_from_mesh = ReadPoseFile(args.object_from_mesh_path, "object_from_mesh");
-  }
-  std::vector<std::string> warnings;
-  const TriangleMesh mesh = LoadMesh(path, options, &warnings);
-  for (const std::string& warning : warnings) std::cerr << "ecvpose: warning: " << warning << '\n';
+  const TriangleMesh mesh = LoadMeshWithArgs(path, args.mesh);
 
   std::vector<std::string> colorings;
   for (const MeshPart& part : mesh.parts) {
@@ -99,7 +89,7 @@ nlohmann::json DescribeMesh(const std::string& path, const InfoArgs& args) {
   std::cout << '\n'
             << "  box       " << Millimetres(size, " x ") << " mm, from (" << Millimetres(box.min(), ", ") << ") mm\n"
             << "  diameter  " << Fixed(1000 * diameter, 1) << " mm\n";
-  if (diameter > 5.0 && args.unit == "m") {
+  if (diameter > 5.0 && args.mesh.unit == "m") {
     std::cerr << "ecvpose: warning: " << path << " is " << diameter
               << " m across; if its unit is millimetres, give --unit mm\n";
   }
@@ -137,15 +127,7 @@ CommandAction SetupInfoCommand(CLI::App& command) {
                      "Frames (frame JSON, YCB-Video prefix, BOP SCENE_DIR:IMAGE_ID, organized .pcd) and meshes "
                      "(.obj .ply .gltf .glb ...)");
   AddFrameFlags(command, &args->frame);
-  command.add_option("--unit", args->unit, "Unit of mesh coordinates")
-      ->check(CLI::IsMember({"m", "cm", "mm"}))
-      ->capture_default_str();
-  command
-      .add_option("--object-from-mesh", args->object_from_mesh_path,
-                  "Pose JSON with key object_from_mesh applied to meshes after the unit")
-      ->check(CLI::ExistingFile);
-  command.add_flag("--allow-missing-textures", args->allow_missing_textures,
-                   "Use the material colour where a texture file is missing (with a warning)");
+  AddMeshFlags(command, &args->mesh);
   command.add_option("--out-json", args->out_json, "Also write what is printed as JSON");
   command.footer(
       "Examples:\n  ecvpose info ../shared/data/ycbv_subset/Example-Scenes/0001/000001\n"
