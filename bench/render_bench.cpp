@@ -4,8 +4,6 @@
 //
 //   render_bench [--views N] [--data DIR] [--results FILE] [--figure FILE]
 
-#include <sched.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -17,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_util.h"
 #include "io/frame_io.h"
 #include "io/mesh_io.h"
 #include "render/overlay.h"
@@ -26,7 +25,10 @@
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using ecv::bench::Clock;
+using ecv::bench::Fixed;
+using ecv::bench::MachineDescription;
+constexpr auto Milliseconds = ecv::bench::MillisecondsSince;
 
 const char* const kObjects[] = {"003_cracker_box",    "004_sugar_box",   "005_tomato_soup_can",
                                 "006_mustard_bottle", "009_gelatin_box", "010_potted_meat_can"};
@@ -38,16 +40,6 @@ struct Settings {
   std::string figure = std::string(ECV_SOURCE_DIR) + "/bench/figures/render_overlay_0001_000001.png";
   std::string command;
 };
-
-double Milliseconds(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-std::string Fixed(double value, int decimals) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%.*f", decimals, value);
-  return text;
-}
 
 // object_from_mesh of `object` from derived/google16k_to_ycbv.txt (p_ycbv = R p_g16k + t).
 Eigen::Isometry3d Google16kToYcbv(const std::string& data, const std::string& object) {
@@ -104,21 +96,6 @@ void SaveOverlayFigure(ecv::Renderer& renderer, const Settings& settings) {
     renderer.RemoveMesh(id);
     std::cout << "wrote " << settings.figure << '\n';
   }
-}
-
-std::string MachineDescription() {
-  cpu_set_t cpus;
-  CPU_ZERO(&cpus);
-  const int count = sched_getaffinity(0, sizeof(cpus), &cpus) == 0 ? CPU_COUNT(&cpus) : 0;  // as `nproc`
-  std::ifstream cpuinfo("/proc/cpuinfo");
-  std::string line, model = "unknown CPU";
-  while (std::getline(cpuinfo, line)) {
-    if (line.rfind("model name", 0) == 0) {
-      model = line.substr(line.find(':') + 2);
-      break;
-    }
-  }
-  return std::to_string(count) + " CPUs (nproc), " + model;
 }
 
 Settings ParseArguments(int argc, char** argv) {
