@@ -5,10 +5,10 @@
 
 #include <flann/algorithms/dist.h>
 #include <flann/algorithms/kdtree_index.h>
-#include <flann/algorithms/kdtree_single_index.h>
 #include <flann/algorithms/linear_index.h>
 
 #include "core/error.h"
+#include "core/point_index.h"
 
 namespace ecv {
 
@@ -124,20 +124,14 @@ double TruePartnerFraction(const std::vector<Primitive>& query, const std::vecto
                            const std::vector<Primitive>& train, const Eigen::Isometry3d& train_from_query,
                            double threshold_m) {
   if (query_indices.empty() || train.empty()) return 0.0;
-  std::vector<float> positions(3 * train.size());
-  for (size_t i = 0; i < train.size(); ++i) std::copy_n(train[i].position.data(), 3, &positions[3 * i]);
-  flann::KDTreeSingleIndex<flann::L2_Simple<float>> index(flann::Matrix<float>(positions.data(), train.size(), 3));
-  index.buildIndex();
+  std::vector<Eigen::Vector3f> positions;
+  for (const Primitive& p : train) positions.push_back(p.position);
+  const PointIndex index(positions);
   const Eigen::Isometry3f transform = train_from_query.cast<float>();
+  const float squared = static_cast<float>(threshold_m * threshold_m);
   int with_partner = 0;
-  std::vector<size_t> nearest(1);
-  std::vector<float> squared(1);
   for (const int i : query_indices) {
-    Eigen::Vector3f moved = transform * query[static_cast<size_t>(i)].position;
-    flann::Matrix<size_t> nearest_matrix(nearest.data(), 1, 1);
-    flann::Matrix<float> squared_matrix(squared.data(), 1, 1);
-    index.knnSearch(flann::Matrix<float>(moved.data(), 1, 3), nearest_matrix, squared_matrix, 1, flann::SearchParams());
-    with_partner += squared[0] < threshold_m * threshold_m ? 1 : 0;
+    with_partner += index.Nearest(transform * query[static_cast<size_t>(i)].position).second < squared ? 1 : 0;
   }
   return static_cast<double>(with_partner) / static_cast<double>(query_indices.size());
 }

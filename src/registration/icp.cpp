@@ -3,33 +3,29 @@
 #include <algorithm>
 #include <cmath>
 
-#include <flann/algorithms/dist.h>
-#include <flann/algorithms/kdtree_single_index.h>
 #include <Eigen/Dense>
 
 #include "core/error.h"
+#include "core/point_index.h"
 
 namespace ecv {
 namespace {
 
-using KdTree = flann::KDTreeSingleIndex<flann::L2_Simple<float>>;
-
 // Unit normals of `points` from the PCA of their k nearest neighbours (sign arbitrary: point-to-plane
 // residuals do not depend on it).
-std::vector<Eigen::Vector3f> EstimateNormals(const std::vector<Eigen::Vector3f>& points, KdTree& tree, int k) {
+std::vector<Eigen::Vector3f> EstimateNormals(const std::vector<Eigen::Vector3f>& points, const PointIndex& index,
+                                             int k) {
   std::vector<Eigen::Vector3f> normals(points.size(), Eigen::Vector3f::Zero());
-  std::vector<size_t> indices(static_cast<size_t>(k));
-  std::vector<float> distances(static_cast<size_t>(k));
   for (size_t i = 0; i < points.size(); ++i) {
-    flann::Matrix<size_t> index_matrix(indices.data(), 1, static_cast<size_t>(k));
-    flann::Matrix<float> distance_matrix(distances.data(), 1, static_cast<size_t>(k));
-    tree.knnSearch(flann::Matrix<float>(const_cast<float*>(points[i].data()), 1, 3), index_matrix, distance_matrix,
-                   static_cast<size_t>(k), flann::SearchParams(-1));
+    const std::vector<int> neighbours = index.KNearest(points[i], k);
     Eigen::Vector3f mean = Eigen::Vector3f::Zero();
-    for (const size_t j : indices) mean += points[j];
-    mean /= static_cast<float>(k);
+    for (const int j : neighbours) mean += points[static_cast<size_t>(j)];
+    mean /= static_cast<float>(neighbours.size());
     Eigen::Matrix3f covariance = Eigen::Matrix3f::Zero();
-    for (const size_t j : indices) covariance += (points[j] - mean) * (points[j] - mean).transpose();
+    for (const int j : neighbours) {
+      const Eigen::Vector3f offset = points[static_cast<size_t>(j)] - mean;
+      covariance += offset * offset.transpose();
+    }
     normals[i] = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3f>(covariance).eigenvectors().col(0);
   }
   return normals;
@@ -63,15 +59,10 @@ IcpResult RefinePointToPlane(const std::vector<Eigen::Vector3f>& object_points,
   IcpResult result;
   result.scene_from_object = initial;
   if (object_points.empty() || scene_points.size() < static_cast<size_t>(options.normal_neighbours)) return result;
-  KdTree tree(flann::Matrix<float>(const_cast<float*>(scene_points[0].data()), scene_points.size(), 3));
-  tree.buildIndex();
+  const PointIndex tree(scene_points);
   const std::vector<Eigen::Vector3f> normals = EstimateNormals(scene_points, tree, options.normal_neighbours);
   const float max_squared = static_cast<float>(options.max_correspondence_m * options.max_correspondence_m);
 
-  size_t index = 0;
-  float squared = 0.0F;
-  flann::Matrix<size_t> index_matrix(&index, 1, 1);
-  flann::Matrix<float> squared_matrix(&squared, 1, 1);
   for (result.iterations = 1; result.iterations <= options.max_iterations; ++result.iterations) {
     // Gauss-Newton on sum ((p' - q) . n)^2 with p' = exp(step) * T * p linearised at step = 0.
     Eigen::Matrix<double, 6, 6> normal_matrix = Eigen::Matrix<double, 6, 6>::Zero();
@@ -80,10 +71,10 @@ IcpResult RefinePointToPlane(const std::vector<Eigen::Vector3f>& object_points,
     int count = 0;
     const Eigen::Isometry3f transform = result.scene_from_object.cast<float>();
     for (const Eigen::Vector3f& point : object_points) {
-      Eigen::Vector3f moved = transform * point;
-      tree.knnSearch(flann::Matrix<float>(moved.data(), 1, 3), index_matrix, squared_matrix, 1,
-                     flann::SearchParams(-1));
+      const Eigen::Vector3f moved = transform * point;
+      const auto [nearest, squared] = tree.Nearest(moved);
       if (squared > max_squared) continue;
+      const size_t index = static_cast<size_t>(nearest);
       const Eigen::Vector3d n = normals[index].cast<double>(), p = moved.cast<double>();
       const double residual = (p - scene_points[index].cast<double>()).dot(n);
       Eigen::Matrix<double, 6, 1> jacobian;

@@ -7,16 +7,13 @@
 #include <random>
 #include <string>
 
-#include <flann/algorithms/dist.h>
-#include <flann/algorithms/kdtree_single_index.h>
 #include <Eigen/Geometry>
 
 #include "core/error.h"
+#include "core/point_index.h"
 
 namespace ecv {
 namespace {
-
-using KdTree = flann::KDTreeSingleIndex<flann::L2_Simple<float>>;
 
 // Rigid motion (Kabsch/Umeyama, no scale) taking `from` onto `to`; false when degenerate.
 bool FitRigid(const std::vector<Eigen::Vector3f>& from, const std::vector<Eigen::Vector3f>& to,
@@ -41,20 +38,15 @@ struct Inliers {
 };
 
 Inliers FindInliers(const std::vector<Eigen::Vector3f>& object_points, const std::vector<Eigen::Vector3f>& scene_points,
-                    KdTree& tree, const Eigen::Isometry3d& scene_from_object, double eps) {
+                    const PointIndex& index, const Eigen::Isometry3d& scene_from_object, double eps) {
   Inliers inliers;
   const Eigen::Isometry3f transform = scene_from_object.cast<float>();
   const float eps_squared = static_cast<float>(eps * eps);
-  size_t index = 0;
-  float squared = 0.0F;
-  flann::Matrix<size_t> index_matrix(&index, 1, 1);
-  flann::Matrix<float> squared_matrix(&squared, 1, 1);
   for (const Eigen::Vector3f& point : object_points) {
-    Eigen::Vector3f moved = transform * point;
-    tree.knnSearch(flann::Matrix<float>(moved.data(), 1, 3), index_matrix, squared_matrix, 1, flann::SearchParams(-1));
+    const auto [nearest, squared] = index.Nearest(transform * point);
     if (squared > eps_squared) continue;
     inliers.object.push_back(point);
-    inliers.scene.push_back(scene_points[index]);
+    inliers.scene.push_back(scene_points[static_cast<size_t>(nearest)]);
     inliers.distance_sum += std::sqrt(squared);
   }
   return inliers;
@@ -108,8 +100,7 @@ RansacResult EstimatePoseRansac(const std::vector<Eigen::Vector3f>& object_point
       ThrowInputError("RANSAC", "correspondences", "indices inside the point sets");
     }
   }
-  KdTree tree(flann::Matrix<float>(const_cast<float*>(scene_points[0].data()), scene_points.size(), 3));
-  tree.buildIndex();
+  const PointIndex tree(scene_points);
 
   const PolygonEdgeCheck polygon(options.polygon_threshold);
   std::mt19937_64 random(options.seed);
