@@ -14,6 +14,7 @@
 #include <iostream>
 #include <map>
 #include <random>
+#include <tuple>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -38,6 +39,27 @@ struct PairScore {
   int hypotheses = 0;
 };
 
+// Expected score of matching at random and the ceiling (share with any true partner within 1 cm) of
+// `query` positions against `train` positions after alignment: {random, ceiling}.
+std::pair<double, double> ChanceAndCeiling(const std::vector<Eigen::Vector3f>& query,
+                                           const std::vector<Eigen::Vector3f>& train,
+                                           const Eigen::Isometry3d& train_from_query) {
+  if (query.empty() || train.empty()) return {0.0, 0.0};
+  const Eigen::Isometry3f transform = train_from_query.cast<float>();
+  const float squared = static_cast<float>(kTrueMatch * kTrueMatch);
+  double random = 0.0;
+  int with_partner = 0;
+  for (const Eigen::Vector3f& point : query) {
+    const Eigen::Vector3f moved = transform * point;
+    int partners = 0;
+    for (const Eigen::Vector3f& other : train) partners += (moved - other).squaredNorm() < squared ? 1 : 0;
+    with_partner += partners > 0 ? 1 : 0;
+    random += static_cast<double>(partners) / static_cast<double>(train.size());
+  }
+  const double n = static_cast<double>(query.size());
+  return {random / n, with_partner / n};
+}
+
 // Nearest-neighbour matching (exact) of valid rows and the paper's score, with random and ceiling.
 PairScore ScoreKeypoints(const KeypointDescriptors& query, const KeypointDescriptors& train,
                          const Eigen::Isometry3d& train_from_query) {
@@ -61,25 +83,20 @@ PairScore ScoreKeypoints(const KeypointDescriptors& query, const KeypointDescrip
 
   const Eigen::Isometry3f transform = train_from_query.cast<float>();
   const float squared = static_cast<float>(kTrueMatch * kTrueMatch);
-  int true_matches = 0, with_partner = 0;
-  double random = 0.0;
+  int true_matches = 0;
   for (const cv::DMatch& match : matches) {
     const Eigen::Vector3f moved =
         transform * query.positions[static_cast<size_t>(query_rows[static_cast<size_t>(match.queryIdx)])];
     const Eigen::Vector3f& matched =
         train.positions[static_cast<size_t>(train_rows[static_cast<size_t>(match.trainIdx)])];
     true_matches += (moved - matched).squaredNorm() < squared ? 1 : 0;
-    int partners = 0;
-    for (const int t : train_rows)
-      partners += (moved - train.positions[static_cast<size_t>(t)]).squaredNorm() < squared ? 1 : 0;
-    with_partner += partners > 0 ? 1 : 0;
-    random += static_cast<double>(partners) / static_cast<double>(train_rows.size());
   }
-  const double n = static_cast<double>(matches.size());
   result.hypotheses = static_cast<int>(matches.size());
-  result.score = true_matches / n;
-  result.random = random / n;
-  result.ceiling = with_partner / n;
+  result.score = true_matches / static_cast<double>(matches.size());
+  std::vector<Eigen::Vector3f> query_positions, train_positions;
+  for (const int q : query_rows) query_positions.push_back(query.positions[static_cast<size_t>(q)]);
+  for (const int t : train_rows) train_positions.push_back(train.positions[static_cast<size_t>(t)]);
+  std::tie(result.random, result.ceiling) = ChanceAndCeiling(query_positions, train_positions, train_from_query);
   return result;
 }
 
@@ -106,16 +123,10 @@ PairScore ScoreEcv(const ViewPair& pair, const PairPrimitives& primitives, const
   result.score = score.Score();
   result.hypotheses = score.hypotheses;
   // Random and ceiling over the described primitives (the same keypoints as the peers at ECV keypoints).
-  KeypointDescriptors q, t;
-  for (const int i : query.primitive) q.positions.push_back(primitives.query[static_cast<size_t>(i)].position);
-  for (const int i : train.primitive) t.positions.push_back(primitives.train[static_cast<size_t>(i)].position);
-  q.values = query.values;
-  t.values = train.values;
-  q.valid.assign(q.positions.size(), true);
-  t.valid.assign(t.positions.size(), true);
-  const PairScore chance = ScoreKeypoints(q, t, pair.TrainFromQuery());
-  result.random = chance.random;
-  result.ceiling = chance.ceiling;
+  std::vector<Eigen::Vector3f> query_positions, train_positions;
+  for (const int i : query.primitive) query_positions.push_back(primitives.query[static_cast<size_t>(i)].position);
+  for (const int i : train.primitive) train_positions.push_back(primitives.train[static_cast<size_t>(i)].position);
+  std::tie(result.random, result.ceiling) = ChanceAndCeiling(query_positions, train_positions, pair.TrainFromQuery());
   return result;
 }
 
