@@ -25,5 +25,6 @@ struct Subcommand {
 CommandAction SetupInfoCommand(CLI::App& command);
 CommandAction SetupFeaturesCommand(CLI::App& command);
 CommandAction SetupRenderCommand(CLI::App& command);  // render/render_command.cpp
+CommandAction SetupRegisterCommand(CLI::App& command);
 
 }  // namespace ecv::app

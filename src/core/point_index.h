@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <utility>
 #include <vector>
@@ -27,6 +28,26 @@ class PointIndex {
   struct Impl;
   std::unique_ptr<Impl> impl_;
   size_t size_ = 0;
+};
+
+/// Nearest point within a fixed radius, by a dense grid over the points' bounding box with cells of at
+/// least twice the radius, so that a query visits at most 8 cells. Several times faster than the kd-tree
+/// for the many fixed-radius queries of RANSAC's inlier count.
+class RadiusGrid {
+ public:
+  RadiusGrid(const std::vector<Eigen::Vector3f>& points, float radius);
+
+  /// Index of the point nearest `query` among those within the radius, and its squared distance (m^2);
+  /// {-1, inf} when there is none.
+  std::pair<int, float> NearestWithin(const Eigen::Vector3f& query) const;
+
+ private:
+  float radius_ = 0.0F, cell_ = 1.0F;
+  Eigen::Vector3f origin_ = Eigen::Vector3f::Zero();
+  Eigen::Vector3i size_ = Eigen::Vector3i::Zero();
+  std::vector<uint32_t> cell_start_;     // points of cell c: sorted_[cell_start_[c] .. cell_start_[c + 1])
+  std::vector<Eigen::Vector3f> sorted_;  // points ordered by cell
+  std::vector<int> sorted_index_;        // their indices in the input
 };
 
 }  // namespace ecv

@@ -9,6 +9,7 @@
 
 #include "core/error.h"
 #include "io/frame_io.h"
+#include "io/points_io.h"
 
 namespace ecv {
 
@@ -43,6 +44,25 @@ void ReadOrganizedPcd(const std::string& path, cv::Mat* points, cv::Mat* color) 
       color->at<cv::Vec3b>(v, u) = {p.r, p.g, p.b};
     }
   }
+}
+
+std::vector<Eigen::Vector3f> ReadPcdPoints(const std::string& path) {
+  if (!std::filesystem::exists(path)) ThrowInputError(path, "point cloud", "an existing .pcd file", "no such file");
+  pcl::PCLPointCloud2 header;
+  pcl::PCDReader reader;
+  if (reader.readHeader(path, header) < 0) ThrowInputError(path, "PCD header", "a valid PCD file");
+  int xyz = 0;
+  for (const pcl::PCLPointField& field : header.fields)
+    xyz += field.name == "x" || field.name == "y" || field.name == "z";
+  if (xyz != 3) ThrowInputError(path, "FIELDS", "x, y and z");
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  if (reader.read(path, cloud) < 0) ThrowInputError(path, "DATA", "readable point data");
+  std::vector<Eigen::Vector3f> points;
+  points.reserve(cloud.size());
+  for (const pcl::PointXYZ& p : cloud) {
+    if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) points.emplace_back(p.x, p.y, p.z);
+  }
+  return points;
 }
 
 LoadedFrame LoadPcdFrame(const std::string& path) {

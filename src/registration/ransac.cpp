@@ -1,11 +1,15 @@
 #include "registration/ransac.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <mutex>
+#include <numeric>
 #include <random>
 #include <string>
+#include <thread>
 
 #include <Eigen/Geometry>
 
@@ -31,26 +35,162 @@ bool FitRigid(const std::vector<Eigen::Vector3f>& from, const std::vector<Eigen:
   return true;
 }
 
-// Inliers of `scene_from_object`: object points within eps of their nearest scene point, with those points.
+// Samples per block. Each block draws from its own generator seeded by (seed, block), so the result does
+// not depend on which thread runs which block.
+constexpr int kBlockSize = 64;
+
+bool Visible(const SceneVisibility& visibility, const Eigen::Vector3f& point_camera) {
+  if (point_camera.z() <= 0.0F) return false;
+  const Eigen::Vector2d pixel = visibility.camera.Project(point_camera.cast<double>());
+  if (!visibility.camera.Contains(pixel)) return false;
+  const int u = std::clamp(static_cast<int>(std::lround(pixel.x())), 0, visibility.depth.cols - 1);
+  const int v = std::clamp(static_cast<int>(std::lround(pixel.y())), 0, visibility.depth.rows - 1);
+  const float depth = visibility.depth.at<float>(v, u);
+  // No measurement: the sensor cannot show the point. Behind the measured surface: hidden. In front of it
+  // (free space), the point stays visible and counts against the pose.
+  return depth > 0.0F && point_camera.z() <= depth + static_cast<float>(visibility.occlusion_margin_m);
+}
+
+// Object points within eps of their nearest scene point under a pose, with those scene points.
 struct Inliers {
   std::vector<Eigen::Vector3f> object, scene;
   double distance_sum = 0.0;
+  size_t visible = 0;
 };
 
-Inliers FindInliers(const std::vector<Eigen::Vector3f>& object_points, const std::vector<Eigen::Vector3f>& scene_points,
-                    const PointIndex& index, const Eigen::Isometry3d& scene_from_object, double eps) {
-  Inliers inliers;
-  const Eigen::Isometry3f transform = scene_from_object.cast<float>();
-  const float eps_squared = static_cast<float>(eps * eps);
-  for (const Eigen::Vector3f& point : object_points) {
-    const auto [nearest, squared] = index.Nearest(transform * point);
-    if (squared > eps_squared) continue;
-    inliers.object.push_back(point);
-    inliers.scene.push_back(scene_points[static_cast<size_t>(nearest)]);
-    inliers.distance_sum += std::sqrt(squared);
-  }
-  return inliers;
+double MeanPairDistance(const Eigen::Isometry3d& pose, const Inliers& inliers) {
+  const Eigen::Isometry3f transform = pose.cast<float>();
+  double sum = 0.0;
+  for (size_t i = 0; i < inliers.object.size(); ++i) sum += (transform * inliers.object[i] - inliers.scene[i]).norm();
+  return sum / static_cast<double>(inliers.object.size());
 }
+
+// One RANSAC problem; RunBlock may be called from several threads at once.
+class Estimator {
+ public:
+  Estimator(const std::vector<Eigen::Vector3f>& object_points, const std::vector<Eigen::Vector3f>& scene_points,
+            const std::vector<Correspondence>& correspondences, const RansacOptions& options,
+            const SceneVisibility* visibility)
+      : object_(object_points),
+        scene_(scene_points),
+        correspondences_(correspondences),
+        options_(options),
+        visibility_(visibility),
+        tree_(scene_points, static_cast<float>(options.inlier_threshold_m)),
+        order_(object_points.size()) {
+    std::iota(order_.begin(), order_.end(), 0);
+    std::mt19937_64 random(options.seed);
+    std::shuffle(order_.begin(), order_.end(), random);
+  }
+
+  struct Best {
+    double error = std::numeric_limits<double>::max();
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    size_t inliers = 0, visible = 0;
+  };
+  struct BlockOutcome {
+    Best best;
+    int iterations = 0, rejected_by_polygon = 0;
+    double agreeing = 0.0;  // largest share of agreeing correspondences of an accepted pose
+    bool stopped_early = false;
+  };
+
+  // Share of the correspondences whose object point lands within eps of its scene point under `pose`.
+  double AgreeingShare(const Eigen::Isometry3d& pose) const {
+    const Eigen::Isometry3f transform = pose.cast<float>();
+    const float eps_squared = static_cast<float>(options_.inlier_threshold_m * options_.inlier_threshold_m);
+    const auto agreeing = std::count_if(correspondences_.begin(), correspondences_.end(), [&](const Correspondence& c) {
+      return (transform * object_[static_cast<size_t>(c.object)] - scene_[static_cast<size_t>(c.scene)])
+                 .squaredNorm() <= eps_squared;
+    });
+    return static_cast<double>(agreeing) / static_cast<double>(correspondences_.size());
+  }
+
+  BlockOutcome RunBlock(int block, int size) const {
+    std::seed_seq seeds{static_cast<uint32_t>(options_.seed), static_cast<uint32_t>(options_.seed >> 32U),
+                        static_cast<uint32_t>(block)};
+    std::mt19937_64 random(seeds);
+    std::uniform_int_distribution<size_t> pick(0, correspondences_.size() - 1);
+    const size_t n = static_cast<size_t>(options_.sample_size);
+    std::vector<Eigen::Vector3f> object_sample(n), scene_sample(n);
+    const PolygonEdgeCheck polygon(options_.polygon_threshold);
+    Inliers inliers;
+    BlockOutcome outcome;
+    while (outcome.iterations < size) {
+      ++outcome.iterations;
+      for (size_t k = 0; k < n; ++k) {
+        const Correspondence& c = correspondences_[pick(random)];
+        object_sample[k] = object_[static_cast<size_t>(c.object)];
+        scene_sample[k] = scene_[static_cast<size_t>(c.scene)];
+      }
+      if (options_.polygon_threshold > 0.0 && !polygon(object_sample, scene_sample)) {
+        ++outcome.rejected_by_polygon;
+        continue;
+      }
+      Eigen::Isometry3d pose;
+      if (!FitRigid(object_sample, scene_sample, &pose) || !FindInliers(pose, &inliers)) continue;
+      // Re-estimate on the inliers; the fit error is that of the same inlier pairs under the new pose.
+      if (!FitRigid(inliers.object, inliers.scene, &pose)) continue;
+      const double error = MeanPairDistance(pose, inliers);
+      if (options_.adaptive) outcome.agreeing = std::max(outcome.agreeing, AgreeingShare(pose));
+      if (error < outcome.best.error) {
+        outcome.best = {error, pose, inliers.object.size(), inliers.visible};
+        if (options_.early_stop_fit_error_m > 0.0 && error < options_.early_stop_fit_error_m) {
+          outcome.stopped_early = true;
+          break;
+        }
+      }
+    }
+    return outcome;
+  }
+
+ private:
+  // Fills `inliers` for `pose`; false as soon as the required fraction can no longer be reached.
+  bool FindInliers(const Eigen::Isometry3d& pose, Inliers* inliers) const {
+    const Eigen::Isometry3f transform = pose.cast<float>();
+    inliers->object.clear();
+    inliers->scene.clear();
+    inliers->distance_sum = 0.0;
+    inliers->visible = object_.size();
+    if (visibility_ != nullptr) {
+      inliers->visible = static_cast<size_t>(std::count_if(
+          object_.begin(), object_.end(), [&](const auto& point) { return Visible(*visibility_, transform * point); }));
+      if (static_cast<double>(inliers->visible) < visibility_->min_visible_fraction * object_.size()) return false;
+    }
+    const size_t required =
+        std::max<size_t>(3, static_cast<size_t>(std::ceil(options_.required_inlier_fraction * inliers->visible)));
+    const float eps_squared = static_cast<float>(options_.inlier_threshold_m * options_.inlier_threshold_m);
+    const double fraction = options_.required_inlier_fraction;
+    const double spread = 3.0 * std::sqrt(fraction * (1.0 - fraction));  // 3 sigma of the binomial, per sqrt(k)
+    size_t remaining = inliers->visible, checked = 0;
+    for (const int index : order_) {
+      const Eigen::Vector3f& point = object_[static_cast<size_t>(index)];
+      const Eigen::Vector3f moved = transform * point;
+      if (visibility_ != nullptr && !Visible(*visibility_, moved)) continue;
+      if (inliers->object.size() + remaining < required) return false;
+      if (options_.preverify && checked >= 50 && checked % 16 == 0) {
+        const double k = static_cast<double>(checked);
+        if (static_cast<double>(inliers->object.size()) < fraction * k - spread * std::sqrt(k)) return false;
+      }
+      --remaining;
+      ++checked;
+      const auto [nearest, squared] = tree_.NearestWithin(moved);
+      if (squared > eps_squared) continue;
+      inliers->object.push_back(point);
+      inliers->scene.push_back(scene_[static_cast<size_t>(nearest)]);
+      inliers->distance_sum += std::sqrt(squared);
+    }
+    return inliers->object.size() >= required;
+  }
+
+  const std::vector<Eigen::Vector3f>& object_;
+  const std::vector<Eigen::Vector3f>& scene_;
+  const std::vector<Correspondence>& correspondences_;
+  const RansacOptions& options_;
+  const SceneVisibility* visibility_;
+  const RadiusGrid tree_;
+  std::vector<int> order_;  // object points in a fixed random order, for the preverification
+};
 
 }  // namespace
 
@@ -65,6 +205,7 @@ void RansacOptions::Check() const {
   require(success_probability > 0.0 && success_probability < 1.0, "success_probability", "in (0, 1)");
   require(expected_inlier_ratio > 0.0 && expected_inlier_ratio <= 1.0, "expected_inlier_ratio", "in (0, 1]");
   require(max_iterations >= 0, "max_iterations", ">= 0 (0: from p, w and n)");
+  require(threads >= 1, "threads", "at least 1");
 }
 
 int RansacOptions::Iterations() const {
@@ -86,56 +227,89 @@ bool PolygonEdgeCheck::operator()(const std::vector<Eigen::Vector3f>& object_sam
   return true;
 }
 
+void SceneVisibility::Check() const {
+  camera.Check("scene visibility camera");
+  if (depth.type() != CV_32FC1 || depth.cols != camera.width || depth.rows != camera.height) {
+    ThrowInputError("scene visibility", "depth", "a CV_32FC1 image of the camera's size");
+  }
+  if (!(occlusion_margin_m >= 0.0)) ThrowInputError("scene visibility", "occlusion_margin_m", ">= 0 m");
+  if (!(min_visible_fraction >= 0.0 && min_visible_fraction <= 1.0)) {
+    ThrowInputError("scene visibility", "min_visible_fraction", "in [0, 1]");
+  }
+}
+
 RansacResult EstimatePoseRansac(const std::vector<Eigen::Vector3f>& object_points,
                                 const std::vector<Eigen::Vector3f>& scene_points,
-                                const std::vector<Correspondence>& correspondences, const RansacOptions& options) {
+                                const std::vector<Correspondence>& correspondences, const RansacOptions& options,
+                                const SceneVisibility* visibility) {
   options.Check();
+  if (visibility != nullptr) visibility->Check();
   const auto start = std::chrono::steady_clock::now();
   RansacResult result;
-  const int n = options.sample_size;
-  if (static_cast<int>(correspondences.size()) < n || object_points.empty() || scene_points.empty()) return result;
+  if (static_cast<int>(correspondences.size()) < options.sample_size || object_points.empty() || scene_points.empty()) {
+    return result;
+  }
   for (const Correspondence& c : correspondences) {
     if (c.object < 0 || c.scene < 0 || c.object >= static_cast<int>(object_points.size()) ||
         c.scene >= static_cast<int>(scene_points.size())) {
       ThrowInputError("RANSAC", "correspondences", "indices inside the point sets");
     }
   }
-  const PointIndex tree(scene_points);
-
-  const PolygonEdgeCheck polygon(options.polygon_threshold);
-  std::mt19937_64 random(options.seed);
-  std::uniform_int_distribution<size_t> pick(0, correspondences.size() - 1);
-  std::vector<Eigen::Vector3f> object_sample(static_cast<size_t>(n)), scene_sample(static_cast<size_t>(n));
-  const size_t required = static_cast<size_t>(std::ceil(options.required_inlier_fraction * object_points.size()));
-  double best_error = std::numeric_limits<double>::max();
+  const Estimator estimator(object_points, scene_points, correspondences, options, visibility);
   const int iterations = options.Iterations();
-  for (result.iterations = 0; result.iterations < iterations;) {
-    ++result.iterations;
-    for (int k = 0; k < n; ++k) {
-      const Correspondence& c = correspondences[pick(random)];
-      object_sample[static_cast<size_t>(k)] = object_points[static_cast<size_t>(c.object)];
-      scene_sample[static_cast<size_t>(k)] = scene_points[static_cast<size_t>(c.scene)];
+  const int blocks = (iterations + kBlockSize - 1) / kBlockSize;
+  auto block_size = [&](int block) { return std::min(kBlockSize, iterations - block * kBlockSize); };
+
+  // Blocks are taken in order. A block that ends the run (early stop, or enough iterations for the
+  // adaptive count) is found in block order, once every block before it is done; later blocks are then
+  // skipped and ignored, so the outcome is that of the serial run whatever the number of threads.
+  std::vector<Estimator::BlockOutcome> outcomes(static_cast<size_t>(blocks));
+  std::vector<char> done(static_cast<size_t>(blocks), 0);
+  std::mutex mutex;
+  int frontier = 0;       // blocks before it are done and checked (guarded by mutex)
+  double agreeing = 0.0;  // largest share of agreeing correspondences so far, in block order (guarded)
+  std::atomic<int> next_block{0};
+  std::atomic<int> stop_block{blocks};
+  auto needed_iterations = [&](double share) {
+    RansacOptions adapted = options;
+    adapted.max_iterations = 0;
+    adapted.expected_inlier_ratio = std::max(share, options.expected_inlier_ratio);
+    return std::min(adapted.Iterations(), iterations);
+  };
+  auto work = [&] {
+    for (int block = next_block++; block < blocks && block <= stop_block.load(); block = next_block++) {
+      outcomes[static_cast<size_t>(block)] = estimator.RunBlock(block, block_size(block));
+      const std::lock_guard<std::mutex> lock(mutex);
+      done[static_cast<size_t>(block)] = 1;
+      for (; frontier < blocks && done[static_cast<size_t>(frontier)] != 0 && frontier < stop_block.load();
+           ++frontier) {
+        const Estimator::BlockOutcome& outcome = outcomes[static_cast<size_t>(frontier)];
+        agreeing = std::max(agreeing, outcome.agreeing);
+        const bool enough = options.adaptive && (frontier + 1) * kBlockSize >= needed_iterations(agreeing);
+        if (outcome.stopped_early || enough) stop_block.store(frontier);
+      }
     }
-    if (options.polygon_threshold > 0.0 && !polygon(object_sample, scene_sample)) {
-      ++result.rejected_by_polygon;
-      continue;
-    }
-    Eigen::Isometry3d hypothesis;
-    if (!FitRigid(object_sample, scene_sample, &hypothesis)) continue;
-    Inliers inliers = FindInliers(object_points, scene_points, tree, hypothesis, options.inlier_threshold_m);
-    if (inliers.object.size() < required || inliers.object.size() < 3) continue;
-    if (!FitRigid(inliers.object, inliers.scene, &hypothesis)) continue;  // re-estimate on the inliers
-    inliers = FindInliers(object_points, scene_points, tree, hypothesis, options.inlier_threshold_m);
-    if (inliers.object.size() < required || inliers.object.empty()) continue;
-    const double error = inliers.distance_sum / static_cast<double>(inliers.object.size());
-    if (error < best_error) {
-      best_error = error;
-      result.success = true;
-      result.scene_from_object = hypothesis;
-      result.inlier_fraction = static_cast<double>(inliers.object.size()) / static_cast<double>(object_points.size());
-      result.fit_error_m = error;
-      if (options.early_stop_fit_error_m > 0.0 && error < options.early_stop_fit_error_m) break;
-    }
+  };
+  std::vector<std::thread> workers;
+  for (int t = 1; t < std::min(options.threads, blocks); ++t) workers.emplace_back(work);
+  work();
+  for (std::thread& worker : workers) worker.join();
+
+  Estimator::Best best;
+  const int last_block = std::min(stop_block.load(), blocks - 1);
+  for (int block = 0; block <= last_block; ++block) {
+    const Estimator::BlockOutcome& outcome = outcomes[static_cast<size_t>(block)];
+    result.iterations += outcome.iterations;
+    result.rejected_by_polygon += outcome.rejected_by_polygon;
+    if (outcome.best.error < best.error) best = outcome.best;
+  }
+  if (best.inliers > 0) result.correspondence_inlier_ratio = estimator.AgreeingShare(best.pose);
+  if (best.inliers > 0) {
+    result.success = true;
+    result.scene_from_object = best.pose;
+    result.fit_error_m = best.error;
+    result.inlier_fraction = static_cast<double>(best.inliers) / static_cast<double>(best.visible);
+    result.visible_fraction = static_cast<double>(best.visible) / static_cast<double>(object_points.size());
   }
   result.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return result;

@@ -4,6 +4,9 @@
 #include <vector>
 
 #include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
+#include "core/camera.h"
 
 namespace ecv {
 
@@ -24,7 +27,17 @@ struct RansacOptions {
   double expected_inlier_ratio = 0.05;    ///< w, of the correspondences
   int max_iterations = 0;                 ///< 0: k = log(1 - p) / log(1 - w^n), about 37 000 by default
   double early_stop_fit_error_m = 0.0;    ///< > 0: stop once an accepted pose fits better than this, metres
-  uint64_t seed = 1;                      ///< same seed, same result
+  /// Beyond the paper: the iteration count is lowered as accepted poses show a larger share w of agreeing
+  /// correspondences (k = log(1 - p) / log(1 - w^n), w from the best pose so far, at most Iterations()).
+  bool adaptive = false;
+  uint64_t seed = 1;  ///< same seed, same result (whatever the number of threads)
+  int threads = 1;    ///< worker threads; the result does not depend on it
+  /// Beyond the paper: object points are checked in a fixed random order and a hypothesis is dropped once
+  /// its inlier count falls 3 standard deviations below the required fraction (binomial), after at least
+  /// 50 points. Wrong poses are then dropped after a few hundred points instead of all of them; a pose
+  /// whose true inlier fraction is at least the required one is dropped with a probability below 0.2 %
+  /// per check. false: every point is checked, as in the paper.
+  bool preverify = true;
 
   /// Throws InputError on values outside their ranges.
   void Check() const;
@@ -33,14 +46,29 @@ struct RansacOptions {
   int Iterations() const;
 };
 
+/// What the scene camera can see. With it, the required inlier fraction counts against the object points
+/// that the pose hypothesis leaves visible (in the image, in front of or on the scene surface, where the
+/// sensor measured depth), so a partly hidden object is not rejected for what it cannot show.
+struct SceneVisibility {
+  cv::Mat depth;                      ///< CV_32FC1 scene depth, metres, 0 = missing
+  PinholeCamera camera;               ///< the scene camera; scene points are in its frame
+  double occlusion_margin_m = 0.01;   ///< an object point further than this behind the scene surface is hidden
+  double min_visible_fraction = 0.2;  ///< hypotheses that leave fewer object points visible are dropped
+
+  /// Throws InputError when the depth image is not CV_32FC1 of the camera's size or a value is out of range.
+  void Check() const;
+};
+
 /// Outcome of one estimation. "Nothing found" is success == false, not an exception.
 struct RansacResult {
   bool success = false;
   Eigen::Isometry3d scene_from_object = Eigen::Isometry3d::Identity();  ///< camera_from_object for a scene frame
-  double inlier_fraction = 0.0;                                         ///< of the object points
-  double fit_error_m = 0.0;     ///< mean distance of the inliers to their nearest scene points, metres
-  int iterations = 0;           ///< samples drawn
-  int rejected_by_polygon = 0;  ///< samples the polygon test dropped before a pose was computed
+  double inlier_fraction = 0.0;              ///< of the object points (of the visible ones, with a SceneVisibility)
+  double correspondence_inlier_ratio = 0.0;  ///< share of the correspondences that agree with the pose
+  double visible_fraction = 1.0;             ///< object points visible under the pose (1 without a SceneVisibility)
+  double fit_error_m = 0.0;                  ///< mean distance of the inlier pairs under the re-estimated pose, metres
+  int iterations = 0;                        ///< samples drawn
+  int rejected_by_polygon = 0;               ///< samples the polygon test dropped before a pose was computed
   double time_ms = 0.0;
 };
 
@@ -56,9 +84,12 @@ class PolygonEdgeCheck {
   double threshold_;
 };
 
-/// Estimates scene_from_object from correspondences between object and scene points (metres).
+/// Estimates scene_from_object from correspondences between object and scene points (metres). Samples are
+/// drawn in blocks with their own seeds, so the result depends on the seed only, not on `options.threads`.
+/// `visibility` (optional) counts the required inliers against the visible object points only.
 RansacResult EstimatePoseRansac(const std::vector<Eigen::Vector3f>& object_points,
                                 const std::vector<Eigen::Vector3f>& scene_points,
-                                const std::vector<Correspondence>& correspondences, const RansacOptions& options = {});
+                                const std::vector<Correspondence>& correspondences, const RansacOptions& options = {},
+                                const SceneVisibility* visibility = nullptr);
 
 }  // namespace ecv

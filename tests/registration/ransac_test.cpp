@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/error.h"
 #include "core/pose.h"
 #include "registration/ransac.h"
 
@@ -107,6 +108,93 @@ TEST(Ransac, SameSeedSameResult) {
   EXPECT_EQ(first.scene_from_object.matrix(), second.scene_from_object.matrix());
   EXPECT_EQ(first.rejected_by_polygon, second.rejected_by_polygon);
   EXPECT_EQ(first.fit_error_m, second.fit_error_m);
+}
+
+TEST(Ransac, TwoThreadsGiveTheSameResultAsOne) {
+  const Problem problem = MakeProblem(300, 40, 400, 0.001, 6);
+  for (const auto& [early_stop, adaptive] : {std::pair{0.0, false}, {0.002, false}, {0.0, true}}) {
+    RansacOptions options;
+    options.max_iterations = 5000;
+    options.early_stop_fit_error_m = early_stop;
+    options.adaptive = adaptive;
+    options.seed = 11;
+    const RansacResult one = EstimatePoseRansac(problem.object, problem.scene, problem.correspondences, options);
+    options.threads = 2;
+    const RansacResult two = EstimatePoseRansac(problem.object, problem.scene, problem.correspondences, options);
+    ASSERT_TRUE(one.success) << "early stop " << early_stop;
+    EXPECT_EQ(one.scene_from_object.matrix(), two.scene_from_object.matrix()) << "early stop " << early_stop;
+    EXPECT_EQ(one.iterations, two.iterations);
+    EXPECT_EQ(one.rejected_by_polygon, two.rejected_by_polygon);
+    EXPECT_EQ(one.fit_error_m, two.fit_error_m);
+    if (early_stop > 0 || adaptive) {
+      EXPECT_LT(one.iterations, 5000) << "the early stop must have cut the run short";
+    }
+    if (adaptive) {  // 40 of 400 correspondences are true: w = 0.1 gives k = log(0.01) / log(1 - 0.001)
+      EXPECT_NEAR(one.correspondence_inlier_ratio, 0.1, 0.02);
+      EXPECT_GE(one.iterations, 4000);
+    }
+    options.seed = 12;  // another seed draws other samples
+    const RansacResult other = EstimatePoseRansac(problem.object, problem.scene, problem.correspondences, options);
+    EXPECT_NE(one.rejected_by_polygon, other.rejected_by_polygon);
+  }
+}
+
+// A flat 20 x 20 cm object 1 m in front of the camera and a wall behind it; the scene sees the object's
+// left 40 % and, in front of the rest, an occluder 20 cm closer.
+struct OccludedProblem {
+  std::vector<Eigen::Vector3f> object, scene;
+  std::vector<Correspondence> correspondences;
+  Eigen::Isometry3d scene_from_object = Eigen::Isometry3d::Identity();
+  SceneVisibility visibility;
+};
+
+OccludedProblem MakeOccludedProblem() {
+  OccludedProblem problem;
+  problem.visibility.camera = {500.0, 500.0, 159.5, 119.5, 320, 240};
+  problem.visibility.depth = cv::Mat(240, 320, CV_32FC1, cv::Scalar(1.0F));
+  problem.scene_from_object.translation() = Eigen::Vector3d(-0.1, -0.1, 1.0);
+  const double occluder_x = -0.1 + 0.4 * 0.2;  // camera-frame x beyond which the object is hidden
+  for (int v = 0; v < 240; ++v) {
+    for (int u = 0; u < 320; ++u) {
+      const Eigen::Vector3d ray = problem.visibility.camera.BackProject({u, v}, 1.0);
+      const bool on_object = ray.x() >= -0.1 && ray.y() >= -0.1 && ray.y() <= 0.1;
+      problem.visibility.depth.at<float>(v, u) = ray.x() > occluder_x ? 0.8F : on_object ? 1.0F : 1.5F;
+      const float z = problem.visibility.depth.at<float>(v, u);
+      if (u % 2 == 0 && v % 2 == 0 && z != 1.0F) problem.scene.push_back((ray * z).cast<float>());
+    }
+  }
+  for (int i = 0; i <= 20; ++i) {
+    for (int j = 0; j <= 20; ++j) problem.object.emplace_back(0.01F * i, 0.01F * j, 0.0F);
+  }
+  for (int i = 0; i < static_cast<int>(problem.object.size()); ++i) {  // the visible part is seen and matched
+    const Eigen::Vector3f in_scene = problem.scene_from_object.cast<float>() * problem.object[i];
+    if (in_scene.x() > occluder_x) continue;
+    problem.correspondences.push_back({i, static_cast<int>(problem.scene.size())});
+    problem.scene.push_back(in_scene);
+  }
+  return problem;
+}
+
+TEST(Ransac, APartlyHiddenObjectIsJudgedByItsVisiblePoints) {
+  const OccludedProblem problem = MakeOccludedProblem();
+  ASSERT_GT(problem.correspondences.size(), 100U);
+  RansacOptions options;
+  options.max_iterations = 500;
+  options.inlier_threshold_m = 0.005;
+  const RansacResult blind = EstimatePoseRansac(problem.object, problem.scene, problem.correspondences, options);
+  EXPECT_FALSE(blind.success) << "only about 40 % of the object points can be inliers";
+  const RansacResult seeing =
+      EstimatePoseRansac(problem.object, problem.scene, problem.correspondences, options, &problem.visibility);
+  ASSERT_TRUE(seeing.success);
+  EXPECT_LT(TranslationDistance(seeing.scene_from_object, problem.scene_from_object), 0.002);
+  EXPECT_LT(RotationAngle(seeing.scene_from_object, problem.scene_from_object), 1.0 * kDegree);
+  EXPECT_NEAR(seeing.visible_fraction, 0.43, 0.05);
+  EXPECT_GT(seeing.inlier_fraction, 0.9);
+
+  SceneVisibility wrong_size = problem.visibility;
+  wrong_size.depth = cv::Mat(10, 10, CV_32FC1, cv::Scalar(1.0F));
+  EXPECT_THROW(EstimatePoseRansac(problem.object, problem.scene, problem.correspondences, options, &wrong_size),
+               InputError);
 }
 
 TEST(Ransac, DegenerateInputsFailWithoutACrash) {
