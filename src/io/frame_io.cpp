@@ -105,8 +105,12 @@ cv::Mat ReadColorImage(const std::string& path) {
 
 void WriteColorImage(const std::string& path, const cv::Mat& image) {
   CV_Assert(image.type() == CV_8UC3 || image.type() == CV_8UC1);
-  cv::Mat converted = image;
-  if (image.channels() == 3) cv::cvtColor(image, converted, cv::COLOR_RGB2BGR);
+  cv::Mat converted;  // a new buffer: converting into a copy of the header would swap the caller's channels
+  if (image.channels() == 3) {
+    cv::cvtColor(image, converted, cv::COLOR_RGB2BGR);
+  } else {
+    converted = image;
+  }
   bool written = false;
   try {
     written = cv::imwrite(path, converted);
