@@ -24,7 +24,8 @@ struct Subcommand {
 
 CommandAction SetupInfoCommand(CLI::App& command);
 CommandAction SetupFeaturesCommand(CLI::App& command);
-CommandAction SetupRenderCommand(CLI::App& command);  // render/render_command.cpp
+CommandAction SetupRenderCommand(CLI::App& command);   // render/render_command.cpp
+CommandAction SetupModeldbCommand(CLI::App& command);  // modeldb/modeldb_command.cpp
 CommandAction SetupRegisterCommand(CLI::App& command);
 
 }  // namespace ecv::app

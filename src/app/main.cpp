@@ -20,6 +20,8 @@ const Subcommand kSubcommands[] = {
      ecv::app::SetupFeaturesCommand},
     {"render", "Render a mesh's views (RGB, metric depth, mask), a model over a frame, or a scene",
      ecv::app::SetupRenderCommand},
+    {"modeldb", "Build the model library (SQLite) from meshes; list, info, remove, verify, export",
+     ecv::app::SetupModeldbCommand},
     {"register", "Align two views of a scene (ECV context + prerejective RANSAC + ICP); writes b_from_a",
      ecv::app::SetupRegisterCommand},
 };

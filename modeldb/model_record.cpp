@@ -1,0 +1,112 @@
+#include "modeldb/model_record.h"
+
+#include <nlohmann/json.hpp>
+
+#include "core/error.h"
+#include "modeldb/content_hash.h"
+
+namespace ecv {
+namespace {
+
+static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "descriptors are stored as little-endian float32");
+
+// Every field of the options (a field added to EcvOptions or DescriptorOptions must be added here too, or a
+// library would not record it).
+nlohmann::ordered_json ToJson(const FeatureSettings& settings) {
+  const EcvOptions& e = settings.ecv;
+  const DescriptorOptions& d = settings.descriptor;
+  nlohmann::ordered_json json;
+  json["ecv"] = {{"wavelength_px", e.monogenic.wavelength_px}, {"sigma_on_f", e.monogenic.sigma_on_f},
+                 {"grid_spacing_px", e.grid_spacing_px},       {"min_magnitude", e.min_magnitude},
+                 {"max_edge_variance", e.max_edge_variance},   {"edge_nms", e.edge_nms},
+                 {"surface_radius_m", e.surface_radius_m},     {"depth_gap_m", e.depth_gap_m},
+                 {"color_radius_px", e.color_radius_px}};
+  json["descriptor"] = {{"radius_m", d.radius_m},
+                        {"max_neighbours", d.max_neighbours},
+                        {"unsigned_segments", d.unsigned_segments},
+                        {"soft_binning", d.soft_binning},
+                        {"use_color", d.use_color},
+                        {"balance_colors", d.balance_colors},
+                        {"hellinger", d.hellinger}};
+  return json;
+}
+
+// Reads `key` of `object` into `value` when present; InputError naming the source and key on a wrong type.
+template <typename T>
+void Read(const nlohmann::json& object, const char* key, T* value, const std::string& source) {
+  if (!object.contains(key)) return;
+  try {
+    *value = object.at(key).get<T>();
+  } catch (const nlohmann::json::exception&) {
+    ThrowInputError(source, key, "a value of the option's type", object.at(key).dump());
+  }
+}
+
+// Unknown keys mean settings this version cannot apply: recognition would extract different features.
+void RejectUnknown(const nlohmann::json& object, const nlohmann::ordered_json& known, const std::string& source) {
+  for (const auto& item : object.items()) {
+    if (!known.contains(item.key())) {
+      ThrowInputError(source, item.key(), "a setting this ecvpose knows (written by a newer version?)");
+    }
+  }
+}
+
+}  // namespace
+
+std::string FeatureSettingsToJson(const FeatureSettings& settings) {
+  return ToJson(settings).dump();
+}
+
+FeatureSettings FeatureSettingsFromJson(const std::string& text, const std::string& source) {
+  const nlohmann::json json = nlohmann::json::parse(text, nullptr, false);
+  if (!json.is_object()) ThrowInputError(source, "feature settings", "a JSON object", text.substr(0, 80));
+  FeatureSettings settings;
+  const nlohmann::ordered_json known = ToJson(settings);
+  RejectUnknown(json, known, source);
+  const nlohmann::json ecv = json.value("ecv", nlohmann::json::object());
+  const nlohmann::json descriptor = json.value("descriptor", nlohmann::json::object());
+  RejectUnknown(ecv, known["ecv"], source + ": ecv");
+  RejectUnknown(descriptor, known["descriptor"], source + ": descriptor");
+  EcvOptions& e = settings.ecv;
+  Read(ecv, "wavelength_px", &e.monogenic.wavelength_px, source);
+  Read(ecv, "sigma_on_f", &e.monogenic.sigma_on_f, source);
+  Read(ecv, "grid_spacing_px", &e.grid_spacing_px, source);
+  Read(ecv, "min_magnitude", &e.min_magnitude, source);
+  Read(ecv, "max_edge_variance", &e.max_edge_variance, source);
+  Read(ecv, "edge_nms", &e.edge_nms, source);
+  Read(ecv, "surface_radius_m", &e.surface_radius_m, source);
+  Read(ecv, "depth_gap_m", &e.depth_gap_m, source);
+  Read(ecv, "color_radius_px", &e.color_radius_px, source);
+  DescriptorOptions& d = settings.descriptor;
+  Read(descriptor, "radius_m", &d.radius_m, source);
+  Read(descriptor, "max_neighbours", &d.max_neighbours, source);
+  Read(descriptor, "unsigned_segments", &d.unsigned_segments, source);
+  Read(descriptor, "soft_binning", &d.soft_binning, source);
+  Read(descriptor, "use_color", &d.use_color, source);
+  Read(descriptor, "balance_colors", &d.balance_colors, source);
+  Read(descriptor, "hellinger", &d.hellinger, source);
+  return settings;
+}
+
+int ModelRecord::NumPrimitives() const {
+  size_t count = 0;
+  for (const ModelView& view : views) count += view.primitives.size();
+  return static_cast<int>(count);
+}
+
+int ModelRecord::NumDescriptors() const {
+  int count = 0;
+  for (const ModelView& view : views) count += view.descriptors.values.rows;
+  return count;
+}
+
+std::string ModelRecord::DescriptorSha256() const {
+  Sha256 hash;
+  for (const ModelView& view : views) {
+    const cv::Mat& values = view.descriptors.values;
+    for (int row = 0; row < values.rows; ++row) hash.Update(values.ptr<float>(row), kDescriptorSize * sizeof(float));
+  }
+  return hash.HexDigest();
+}
+
+}  // namespace ecv

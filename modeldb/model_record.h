@@ -1,0 +1,90 @@
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "core/camera.h"
+#include "ecv/descriptor.h"
+#include "ecv/primitives.h"
+
+namespace ecv {
+
+/// The feature settings of a library: every model in one library is built with the same ones, and
+/// recognition extracts the scene's features with them too.
+struct FeatureSettings {
+  EcvOptions ecv;
+  DescriptorOptions descriptor;
+};
+
+/// The settings as canonical JSON text (every field, fixed order), as stored in the library.
+std::string FeatureSettingsToJson(const FeatureSettings& settings);
+
+/// Settings from JSON text; fields that are missing keep their defaults. Throws InputError naming `source`.
+FeatureSettings FeatureSettingsFromJson(const std::string& text, const std::string& source);
+
+/// One rendered view of a library model.
+struct ModelView {
+  int index = 0;                                                         ///< 0.. within the model
+  PinholeCamera camera;                                                  ///< intrinsics it was rendered with
+  Eigen::Isometry3d camera_from_object = Eigen::Isometry3d::Identity();  ///< metres
+  std::vector<Primitive> primitives;  ///< object frame (positions in metres, orientations unit vectors)
+  Descriptors descriptors;            ///< rows refer to `primitives` (only primitives with a context have one)
+};
+
+/// A whole library model: where it came from, how it was built, and its views.
+struct ModelRecord {
+  std::string name;         ///< unique in a library
+  std::string mesh_path;    ///< the mesh file it was built from
+  std::string mesh_sha256;  ///< SHA-256 of the mesh file followed by its texture files
+  std::string unit = "m";   ///< unit of the mesh file's coordinates: "m", "cm" or "mm"
+  /// Applied to the mesh after the unit change: x_object = R x_mesh + t (metres).
+  Eigen::Isometry3d object_from_mesh = Eigen::Isometry3d::Identity();
+  double diameter_m = 0.0;         ///< largest distance between two vertices, metres
+  bool symmetric = false;          ///< evaluated with ADD-S instead of ADD
+  std::string build_options_json;  ///< how the views were made (views, camera, distance, shading), JSON
+  FeatureSettings features;        ///< extraction and descriptor settings used
+  std::vector<ModelView> views;
+
+  int NumPrimitives() const;
+  int NumDescriptors() const;
+  /// SHA-256 of all descriptor values (float32, little-endian) in view and row order: equal digests mean
+  /// the descriptors are equal bit for bit.
+  std::string DescriptorSha256() const;
+};
+
+/// A 3x3 colour matrix of a model (paper Sect. IV-C): c_scene = model_to_scene * c_model (RGB in [0, 1]).
+struct ColorMatrixRecord {
+  Eigen::Matrix3d model_to_scene = Eigen::Matrix3d::Identity();
+  double rms = 0.0;     ///< RMS residual of the fit, colour units in [0, 1]
+  std::string source;   ///< how it was fitted, e.g. "pairs:bench/pairs.csv" or "auto:0001/000001"
+  std::string created;  ///< UTC time of storing, ISO 8601 (set by the database)
+};
+
+/// A model as loaded from a library: its record and its colour matrix, read in one transaction.
+struct StoredModel {
+  ModelRecord record;
+  std::optional<ColorMatrixRecord> color_matrix;  ///< nullopt when not calibrated
+};
+
+/// What the database says about one model, without its views.
+struct ModelSummary {
+  std::string name;
+  std::string mesh_path;
+  std::string mesh_sha256;
+  std::string unit;
+  Eigen::Isometry3d object_from_mesh = Eigen::Isometry3d::Identity();
+  double diameter_m = 0.0;
+  bool symmetric = false;
+  std::string build_options_json;
+  int num_views = 0;
+  int num_primitives = 0;
+  int num_descriptors = 0;
+  std::string descriptor_sha256;
+  bool has_color_matrix = false;
+  std::string created;  ///< UTC time of storing, ISO 8601
+};
+
+}  // namespace ecv

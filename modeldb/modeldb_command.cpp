@@ -1,0 +1,344 @@
+// `ecvpose modeldb`: build a model library from meshes into SQLite, and list, inspect, remove, verify, export
+// and migrate it. Compiled only into the ecvpose executable; reads flags into options and calls ecv_modeldb.
+
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "app/commands.h"
+#include "app/frame_args.h"
+#include "core/error.h"
+#include "io/frame_io.h"
+#include "io/ply_io.h"
+#include "io/pose_io.h"
+#include "modeldb/mesh_sources.h"
+#include "modeldb/model_builder.h"
+#include "modeldb/model_database.h"
+#include "modeldb/schema.h"
+
+namespace ecv::app {
+namespace {
+
+struct ModeldbArgs {
+  std::string db;
+  // build
+  std::vector<std::string> inputs;
+  int views = ModelBuildOptions::DefaultSampling().num_views;
+  MeshArgs mesh;
+  std::string name;
+  std::string camera;
+  std::string size = "640x480";
+  double distance_m = ModelBuildOptions().distance_m;
+  std::string shading = "unlit";
+  bool symmetric = false;
+  // list, info, remove, export, verify
+  std::string model;
+  bool json = false;
+  std::string ply;
+  int view = -1;
+  std::string color_by = "type";
+  bool quick = false;
+};
+
+std::string Fixed(double value, int decimals) {
+  char text[64];
+  std::snprintf(text, sizeof(text), "%.*f", decimals, value);
+  return text;
+}
+
+// --camera fx,fy,cx,cy and --size WxH; the YCB-Video camera by default.
+PinholeCamera CameraArgument(const ModeldbArgs& args) {
+  PinholeCamera camera = YcbVideoCamera();
+  if (!args.camera.empty()) {
+    const auto k = ParseIntrinsics(args.camera, "--camera");
+    camera.fx = k[0], camera.fy = k[1], camera.cx = k[2], camera.cy = k[3];
+  }
+  char x = 0;
+  std::istringstream size(args.size);
+  if (!(size >> camera.width >> x >> camera.height) || x != 'x' || !(size >> std::ws).eof()) {
+    ThrowInputError("--size", "image size", "WIDTHxHEIGHT in pixels, e.g. 640x480", args.size);
+  }
+  camera.Check("--camera/--size");
+  return camera;
+}
+
+ModelBuildOptions BuildArguments(const ModeldbArgs& args) {
+  ModelBuildOptions options;
+  options.sampling.num_views = args.views;
+  options.distance_m = args.distance_m;
+  options.camera = CameraArgument(args);
+  options.render.shading = args.shading == "headlight" ? Shading::kHeadlight : Shading::kUnlit;
+  options.Check();
+  return options;
+}
+
+ModelSource SourceDefaults(const ModeldbArgs& args) {
+  ModelSource defaults;
+  defaults.name = args.name;
+  defaults.unit = args.mesh.unit;
+  defaults.allow_missing_textures = args.mesh.allow_missing_textures;
+  defaults.symmetric = args.symmetric;
+  if (!args.mesh.object_from_mesh_path.empty()) {
+    defaults.object_from_mesh = ReadPoseFile(args.mesh.object_from_mesh_path, "object_from_mesh");
+  }
+  return defaults;
+}
+
+// Builds and stores one model; returns false (after reporting) when it failed.
+bool BuildOne(const ModelSource& source, const ModelBuildOptions& options, const std::string& tag, Renderer& renderer,
+              ModelDatabase& database) {
+  const std::string prefix = "modeldb: " + tag + " " + source.name;
+  std::cerr << prefix << ": building " << options.sampling.num_views << " views of " << source.mesh_path << '\n';
+  try {
+    const BuildResult built = BuildModel(source, options, renderer, [&](const BuildProgress& p) {
+      std::cerr << prefix << ": view " << p.view << "/" << p.num_views << ": " << p.primitives << " primitives, "
+                << p.descriptors << " descriptors\n";
+    });
+    for (const std::string& warning : built.warnings) std::cerr << prefix << ": warning: " << warning << '\n';
+    const AddModelResult added = database.AddModel(built.record);
+    const BuildTimings& t = built.timings;
+    std::cerr << prefix << ": stored " << built.record.views.size() << " views, " << built.record.NumPrimitives()
+              << " primitives, " << built.record.NumDescriptors() << " descriptors (render "
+              << Fixed(t.render_ms / 1000, 1) << " s, extract " << Fixed(t.extract_ms / 1000, 1) << " s, describe "
+              << Fixed(t.describe_ms / 1000, 1) << " s, insert " << Fixed(added.insert_ms / 1000, 1) << " s)"
+              << (added.replaced ? "; replaced the earlier model" : "")
+              << (added.color_matrix_kept ? ", kept its colour matrix" : "")
+              << (added.color_matrix_dropped ? ", dropped its colour matrix (the mesh changed)" : "") << '\n';
+    return true;
+  } catch (const InputError& error) {
+    std::cerr << prefix << ": FAILED: " << error.what() << '\n';
+  } catch (const SqlError& error) {
+    std::cerr << prefix << ": FAILED: " << error.what() << '\n';
+  }
+  return false;
+}
+
+int RunBuild(const ModeldbArgs& args) {
+  if (!args.name.empty() && args.inputs.size() != 1) {
+    std::cerr << "ecvpose modeldb build: --name needs exactly one MESH\n";
+    return kExitBadUsage;
+  }
+  const ModelBuildOptions options = BuildArguments(args);
+  const MeshSourceScan scan =
+      FindMeshSources(args.inputs, SourceDefaults(args), args.mesh.object_from_mesh_path.empty());
+  if (!args.name.empty() && scan.sources.size() > 1) {
+    std::cerr << "ecvpose modeldb build: --name needs a single mesh, " << args.inputs[0] << " holds "
+              << scan.sources.size() << '\n';
+    return kExitBadUsage;
+  }
+  for (const std::string& problem : scan.problems) std::cerr << "modeldb: FAILED: " << problem << '\n';
+  ModelDatabase database(args.db, OpenMode::kCreate);  // before rendering: a bad --db fails at once
+  Renderer renderer;
+  std::vector<std::string> failed;
+  for (size_t i = 0; i < scan.sources.size(); ++i) {
+    const std::string tag = "[" + std::to_string(i + 1) + "/" + std::to_string(scan.sources.size()) + "]";
+    if (!BuildOne(scan.sources[i], options, tag, renderer, database)) failed.push_back(scan.sources[i].name);
+  }
+  const size_t built = scan.sources.size() - failed.size();
+  std::cout << "built " << built << " of " << scan.sources.size() + scan.problems.size() << " models into " << args.db;
+  if (!failed.empty() || !scan.problems.empty()) {
+    std::cout << "; failed (see above):";
+    for (const std::string& name : failed) std::cout << ' ' << name;
+    for (const std::string& problem : scan.problems) std::cout << ' ' << problem.substr(0, problem.find(':'));
+  }
+  std::cout << '\n';
+  return failed.empty() && scan.problems.empty() && built > 0 ? kExitOk : kExitBadInput;
+}
+
+nlohmann::ordered_json SummaryJson(const ModelSummary& m) {
+  return {{"name", m.name},
+          {"mesh_path", m.mesh_path},
+          {"mesh_sha256", m.mesh_sha256},
+          {"unit", m.unit},
+          {"object_from_mesh", PoseToJson(m.object_from_mesh)},
+          {"diameter_m", m.diameter_m},
+          {"symmetric", m.symmetric},
+          {"views", m.num_views},
+          {"primitives", m.num_primitives},
+          {"descriptors", m.num_descriptors},
+          {"descriptor_sha256", m.descriptor_sha256},
+          {"color_matrix", m.has_color_matrix},
+          {"build_options", nlohmann::json::parse(m.build_options_json, nullptr, false)},
+          {"created", m.created}};
+}
+
+int RunList(const ModeldbArgs& args) {
+  const ModelDatabase database(args.db, OpenMode::kReadOnly);
+  const std::vector<ModelSummary> models = database.ListModels();
+  if (args.json) {
+    nlohmann::ordered_json list = nlohmann::ordered_json::array();
+    for (const ModelSummary& model : models) list.push_back(SummaryJson(model));
+    std::cout << list.dump(2) << '\n';
+    return kExitOk;
+  }
+  std::printf("%s: %zu models (schema version %d)\n", args.db.c_str(), models.size(), kModelDbSchemaVersion);
+  if (models.empty()) return kExitOk;
+  std::printf("%-28s %6s %11s %12s %12s %9s %7s  %s\n", "name", "views", "primitives", "descriptors", "diameter_mm",
+              "symmetric", "colour", "created");
+  for (const ModelSummary& m : models) {
+    std::printf("%-28s %6d %11d %12d %12.1f %9s %7s  %s\n", m.name.c_str(), m.num_views, m.num_primitives,
+                m.num_descriptors, 1000.0 * m.diameter_m, m.symmetric ? "yes" : "no", m.has_color_matrix ? "yes" : "no",
+                m.created.c_str());
+  }
+  return kExitOk;
+}
+
+int RunInfo(const ModeldbArgs& args) {
+  const ModelDatabase database(args.db, OpenMode::kReadOnly);
+  const std::optional<ModelSummary> model = database.FindModel(args.model);
+  if (!model) {
+    std::cerr << "ecvpose: error: " << args.db << ": no model \"" << args.model << "\" (see `ecvpose modeldb list`)\n";
+    return kExitBadInput;
+  }
+  nlohmann::ordered_json json = SummaryJson(*model);
+  if (const std::optional<ColorMatrixRecord> matrix = database.GetColorMatrix(args.model)) {
+    const Eigen::Matrix3d& a = matrix->model_to_scene;
+    json["color_matrix"] = {
+        {"model_to_scene", {{a(0, 0), a(0, 1), a(0, 2)}, {a(1, 0), a(1, 1), a(1, 2)}, {a(2, 0), a(2, 1), a(2, 2)}}},
+        {"rms", matrix->rms},
+        {"source", matrix->source},
+        {"created", matrix->created}};
+  }
+  if (const std::optional<FeatureSettings> features = database.feature_settings()) {
+    json["features"] = nlohmann::json::parse(FeatureSettingsToJson(*features));
+  }
+  if (args.json) {
+    std::cout << json.dump(2) << '\n';
+    return kExitOk;
+  }
+  for (const auto& item : json.items()) {
+    std::cout << item.key() << ": "
+              << (item.value().is_string() ? item.value().get<std::string>() : item.value().dump());
+    if (item.key() == "diameter_m") std::cout << " (" << Fixed(1000.0 * model->diameter_m, 1) << " mm)";
+    std::cout << '\n';
+  }
+  return kExitOk;
+}
+
+int RunRemove(const ModeldbArgs& args) {
+  ModelDatabase database(args.db, OpenMode::kReadWrite);
+  if (!database.RemoveModel(args.model)) {
+    std::cerr << "ecvpose: error: " << args.db << ": no model \"" << args.model << "\" to remove\n";
+    return kExitBadInput;
+  }
+  std::cout << "removed " << args.model << " from " << args.db << '\n';
+  return kExitOk;
+}
+
+int RunVerify(const ModeldbArgs& args) {
+  const ModelDatabase database(args.db, OpenMode::kReadOnly);
+  const VerifyReport report = database.Verify(!args.quick);
+  std::cout << args.db << ": " << report.models << " models, " << report.views << " views, " << report.primitives
+            << " primitives, " << report.descriptors << " descriptors\n";
+  for (const std::string& problem : report.problems) std::cout << "problem: " << problem << '\n';
+  std::cout << (report.ok() ? "ok" : "NOT consistent") << '\n';
+  return report.ok() ? kExitOk : kExitBadInput;
+}
+
+int RunExport(const ModeldbArgs& args) {
+  const ModelDatabase database(args.db, OpenMode::kReadOnly);
+  const std::vector<StoredModel> models = database.LoadModels({args.model});
+  const ModelRecord& record = models.at(0).record;
+  if (args.view >= static_cast<int>(record.views.size())) {
+    ThrowInputError("--view", "view index", "0.." + std::to_string(record.views.size() - 1), std::to_string(args.view));
+  }
+  std::vector<Primitive> primitives;
+  for (const ModelView& view : record.views) {
+    if (args.view >= 0 && view.index != args.view) continue;
+    primitives.insert(primitives.end(), view.primitives.begin(), view.primitives.end());
+  }
+  if (args.color_by == "type") {  // segments red, texlets blue (the type is also a PLY property)
+    for (Primitive& p : primitives) {
+      p.color =
+          p.type == PrimitiveType::kSegment ? Eigen::Vector3f(1.0F, 0.1F, 0.1F) : Eigen::Vector3f(0.1F, 0.4F, 1.0F);
+    }
+  }
+  WritePrimitivesPly(args.ply, primitives);
+  std::cout << "wrote " << primitives.size() << " primitives of " << args.model << " (object frame, metres, "
+            << (args.view >= 0 ? "view " + std::to_string(args.view) : "all views") << ") to " << args.ply << '\n';
+  return kExitOk;
+}
+
+int RunMigrate(const ModeldbArgs& args) {
+  const ModelDbMigration migration = MigrateModelDatabase(args.db);
+  if (migration.steps.empty()) {
+    std::cout << args.db << ": already at schema version " << migration.to_version << '\n';
+    return kExitOk;
+  }
+  for (const std::string& step : migration.steps) std::cout << "step " << step << '\n';
+  std::cout << "migrated " << args.db << " from schema version " << migration.from_version << " to "
+            << migration.to_version << '\n';
+  return kExitOk;
+}
+
+CLI::App* AddDatabaseCommand(CLI::App& command, const char* name, const char* summary, ModeldbArgs* args) {
+  CLI::App* sub = command.add_subcommand(name, summary);
+  sub->add_option("--db", args->db, "Model library file (SQLite)")->required();
+  return sub;
+}
+
+void AddBuildFlags(CLI::App& build, ModeldbArgs* args) {
+  build.add_option("MESH_OR_DIR", args->inputs, "Mesh files, or directories of <name>/<name>.obj folders")->required();
+  build.add_option("--views", args->views, "Rendered views per model")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  AddMeshFlags(build, &args->mesh);
+  build.add_option("--name", args->name, "Model name (one mesh only; default: the file stem or folder name)");
+  build.add_option("--camera", args->camera, "Intrinsics fx,fy,cx,cy of the views (default: YCB-Video's)");
+  build.add_option("--size", args->size, "Image size of the views, WIDTHxHEIGHT")->capture_default_str();
+  build
+      .add_option("--distance", args->distance_m,
+                  "Camera distance from the object centre, metres; farther if the object would not fit (0: fit)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  build.add_option("--shading", args->shading, "unlit (texture colours as stored) or headlight")
+      ->check(CLI::IsMember({"unlit", "headlight"}))
+      ->capture_default_str();
+  build.add_flag("--symmetric", args->symmetric, "Mark the models symmetric (evaluated with ADD-S)");
+  build.footer(
+      "A directory holds one folder per model, <name>/<name>.obj, with object_from_mesh.json beside the mesh when\n"
+      "the mesh's frame differs from the object frame; --object-from-mesh FILE overrides those for every mesh.\n"
+      "Each model is stored in one transaction; a model that exists is replaced. Exit code 1 if any failed.");
+}
+
+}  // namespace
+
+CommandAction SetupModeldbCommand(CLI::App& command) {
+  auto args = std::make_shared<ModeldbArgs>();
+  command.require_subcommand(1);
+  CLI::App* build = AddDatabaseCommand(command, "build", "Build models from meshes into the library", args.get());
+  AddBuildFlags(*build, args.get());
+  CLI::App* list = AddDatabaseCommand(command, "list", "List the library's models", args.get());
+  list->add_flag("--json", args->json, "JSON instead of a table");
+  CLI::App* info = AddDatabaseCommand(command, "info", "Describe one model", args.get());
+  info->add_option("NAME", args->model, "Model name")->required();
+  info->add_flag("--json", args->json, "JSON instead of text");
+  CLI::App* remove = AddDatabaseCommand(command, "remove", "Remove a model with its views", args.get());
+  remove->add_option("NAME", args->model, "Model name")->required();
+  CLI::App* verify = AddDatabaseCommand(command, "verify", "Check the library's consistency", args.get());
+  verify->add_flag("--quick", args->quick, "Skip re-hashing every model's descriptors");
+  CLI::App* exported = AddDatabaseCommand(command, "export", "Write a model's primitives to a PLY", args.get());
+  exported->add_option("NAME", args->model, "Model name")->required();
+  exported->add_option("--ply", args->ply, "Output PLY (object frame, metres)")->required();
+  exported->add_option("--view", args->view, "Only this view (default: all)");
+  exported->add_option("--color-by", args->color_by, "type (segments red, texlets blue) or colour")
+      ->check(CLI::IsMember({"type", "colour", "color"}))
+      ->capture_default_str();
+  CLI::App* migrate =
+      AddDatabaseCommand(command, "migrate", "Bring a library of an older schema up to date", args.get());
+  return [args, build, list, info, remove, verify, exported, migrate]() -> int {
+    if (build->parsed()) return RunBuild(*args);
+    if (list->parsed()) return RunList(*args);
+    if (info->parsed()) return RunInfo(*args);
+    if (remove->parsed()) return RunRemove(*args);
+    if (verify->parsed()) return RunVerify(*args);
+    if (exported->parsed()) return RunExport(*args);
+    if (migrate->parsed()) return RunMigrate(*args);
+    return kExitBadUsage;
+  };
+}
+
+}  // namespace ecv::app

@@ -1,0 +1,256 @@
+// The only file that calls SQLite: a small RAII layer (connection, statement, transaction) whose errors name
+// the database file and the statement.
+
+#include "modeldb/sql.h"
+
+#include <sqlite3.h>
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <utility>
+
+namespace ecv {
+namespace {
+
+SqlErrorKind KindOf(int code) {
+  switch (code & 0xFF) {
+    case SQLITE_NOTADB: return SqlErrorKind::kNotADatabase;
+    case SQLITE_CANTOPEN: return SqlErrorKind::kCannotOpen;
+    case SQLITE_BUSY:
+    case SQLITE_LOCKED: return SqlErrorKind::kBusy;
+    case SQLITE_READONLY:
+    case SQLITE_PERM:
+    case SQLITE_AUTH: return SqlErrorKind::kReadOnly;
+    case SQLITE_CORRUPT: return SqlErrorKind::kCorrupt;
+    case SQLITE_CONSTRAINT: return SqlErrorKind::kConstraint;
+    case SQLITE_FULL:
+    case SQLITE_IOERR: return SqlErrorKind::kFull;
+    default: return SqlErrorKind::kOther;
+  }
+}
+
+// "file:PATH?immutable=1" with the characters that URIs reserve escaped.
+std::string ImmutableUri(const std::string& path) {
+  std::string uri = "file:";
+  for (const char c : path) {
+    if (c == '?' || c == '#' || c == '%') {
+      static const char kHex[] = "0123456789ABCDEF";
+      const auto byte = static_cast<unsigned char>(c);
+      uri += {'%', kHex[byte >> 4], kHex[byte & 0xF]};
+    } else {
+      uri += c;
+    }
+  }
+  return uri + "?immutable=1";
+}
+
+bool DirectoryWritable(const std::string& path) {
+  std::filesystem::path directory = std::filesystem::absolute(path).parent_path();
+  return access(directory.c_str(), W_OK) == 0;
+}
+
+}  // namespace
+
+struct SqlConnection::Impl {
+  std::string path;
+  sqlite3* db = nullptr;
+  bool immutable = false;
+
+  ~Impl() { Close(); }
+  void Close() {
+    if (db != nullptr) sqlite3_close_v2(db);
+    db = nullptr;
+  }
+
+  [[noreturn]] void Fail(int code, const std::string& context) const {
+    const std::string detail = db != nullptr ? sqlite3_errmsg(db) : sqlite3_errstr(code);
+    throw SqlError(path + ": " + context + ": " + detail, KindOf(code));
+  }
+
+  void Open(const std::string& name, int flags, int busy_timeout_ms) {
+    Close();
+    const int code = sqlite3_open_v2(name.c_str(), &db, flags | SQLITE_OPEN_URI, nullptr);
+    if (code != SQLITE_OK) Fail(code, "cannot open");
+    sqlite3_extended_result_codes(db, 1);
+    sqlite3_busy_timeout(db, busy_timeout_ms);
+  }
+
+  // Reads the header, so that a file that is not a database fails here rather than at the first query.
+  int Probe() const { return sqlite3_exec(db, "PRAGMA schema_version", nullptr, nullptr, nullptr); }
+};
+
+SqlConnection::SqlConnection(const std::string& path, SqlOpenMode mode, int busy_timeout_ms)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->path = path;
+  const bool memory = path == ":memory:";
+  if (mode != SqlOpenMode::kCreate && !memory && !std::filesystem::is_regular_file(path)) {
+    throw SqlError(path + ": no such file", SqlErrorKind::kCannotOpen);
+  }
+  const int flags = mode == SqlOpenMode::kReadOnly    ? SQLITE_OPEN_READONLY
+                    : mode == SqlOpenMode::kReadWrite ? SQLITE_OPEN_READWRITE
+                                                      : SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE;
+  impl_->Open(path, flags, busy_timeout_ms);
+  int code = impl_->Probe();
+  // A WAL database in a location we cannot write has no shared-memory file to coordinate through; nobody can
+  // be writing it, so it is read as immutable.
+  if (code != SQLITE_OK && mode == SqlOpenMode::kReadOnly && KindOf(code) != SqlErrorKind::kNotADatabase && !memory &&
+      !DirectoryWritable(path)) {
+    impl_->Open(ImmutableUri(path), SQLITE_OPEN_READONLY, busy_timeout_ms);
+    impl_->immutable = true;
+    code = impl_->Probe();
+  }
+  if (code != SQLITE_OK) impl_->Fail(code, "cannot read");
+}
+
+SqlConnection::~SqlConnection() = default;
+SqlConnection::SqlConnection(SqlConnection&&) noexcept = default;
+SqlConnection& SqlConnection::operator=(SqlConnection&&) noexcept = default;
+
+void SqlConnection::Execute(const std::string& sql) {
+  char* error = nullptr;
+  const int code = sqlite3_exec(impl_->db, sql.c_str(), nullptr, nullptr, &error);
+  if (code != SQLITE_OK) {
+    const std::string detail = error != nullptr ? error : sqlite3_errstr(code);
+    sqlite3_free(error);
+    throw SqlError(impl_->path + ": " + sql.substr(0, 60) + ": " + detail, KindOf(code));
+  }
+}
+
+int64_t SqlConnection::LastInsertRowId() const {
+  return sqlite3_last_insert_rowid(impl_->db);
+}
+
+void SqlConnection::RollbackIfActive() noexcept {
+  if (impl_ && impl_->db != nullptr && sqlite3_get_autocommit(impl_->db) == 0) {
+    sqlite3_exec(impl_->db, "ROLLBACK", nullptr, nullptr, nullptr);
+  }
+}
+
+bool SqlConnection::read_only() const {
+  return sqlite3_db_readonly(impl_->db, "main") == 1;
+}
+
+int SqlConnection::Changes() const {
+  return sqlite3_changes(impl_->db);
+}
+
+const std::string& SqlConnection::path() const {
+  return impl_->path;
+}
+
+bool SqlConnection::immutable() const {
+  return impl_->immutable;
+}
+
+struct SqlStatement::Impl {
+  const SqlConnection::Impl* connection = nullptr;
+  sqlite3_stmt* statement = nullptr;
+  ~Impl() { sqlite3_finalize(statement); }
+
+  // Throws with the statement's text and the engine's message, leaving the statement reset for reuse.
+  [[noreturn]] void Fail(int code) const {
+    const std::string sql = sqlite3_sql(statement);
+    const std::string detail = sqlite3_errmsg(connection->db);
+    sqlite3_reset(statement);
+    throw SqlError(connection->path + ": " + sql.substr(0, 60) + ": " + detail, KindOf(code));
+  }
+  void Check(int code) const {
+    if (code != SQLITE_OK) Fail(code);
+  }
+};
+
+SqlStatement SqlConnection::Prepare(const std::string& sql) {
+  auto statement = std::make_unique<SqlStatement::Impl>();
+  statement->connection = impl_.get();
+  const int code =
+      sqlite3_prepare_v2(impl_->db, sql.c_str(), static_cast<int>(sql.size()), &statement->statement, nullptr);
+  if (code != SQLITE_OK) impl_->Fail(code, sql.substr(0, 60));
+  return SqlStatement(std::move(statement));
+}
+
+SqlStatement::SqlStatement(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+SqlStatement::~SqlStatement() = default;
+SqlStatement::SqlStatement(SqlStatement&&) noexcept = default;
+SqlStatement& SqlStatement::operator=(SqlStatement&&) noexcept = default;
+
+SqlStatement& SqlStatement::Bind(int index, int64_t value) {
+  impl_->Check(sqlite3_bind_int64(impl_->statement, index, value));
+  return *this;
+}
+
+SqlStatement& SqlStatement::Bind(int index, double value) {
+  impl_->Check(sqlite3_bind_double(impl_->statement, index, value));
+  return *this;
+}
+
+SqlStatement& SqlStatement::Bind(int index, const std::string& value) {
+  impl_->Check(
+      sqlite3_bind_text(impl_->statement, index, value.data(), static_cast<int>(value.size()), SQLITE_TRANSIENT));
+  return *this;
+}
+
+SqlStatement& SqlStatement::BindBlob(int index, const void* data, size_t size) {
+  impl_->Check(sqlite3_bind_blob64(impl_->statement, index, data, size, SQLITE_TRANSIENT));
+  return *this;
+}
+
+SqlStatement& SqlStatement::BindNull(int index) {
+  impl_->Check(sqlite3_bind_null(impl_->statement, index));
+  return *this;
+}
+
+bool SqlStatement::Step() {
+  const int code = sqlite3_step(impl_->statement);
+  if (code == SQLITE_ROW) return true;
+  if (code == SQLITE_DONE) return false;
+  impl_->Fail(code);
+}
+
+void SqlStatement::Run() {
+  while (Step()) {
+  }
+  Reset();
+}
+
+void SqlStatement::Reset() {
+  sqlite3_reset(impl_->statement);
+}
+
+int64_t SqlStatement::Int(int column) const {
+  return sqlite3_column_int64(impl_->statement, column);
+}
+
+double SqlStatement::Double(int column) const {
+  return sqlite3_column_double(impl_->statement, column);
+}
+
+std::string SqlStatement::Text(int column) const {
+  const unsigned char* text = sqlite3_column_text(impl_->statement, column);
+  return text != nullptr ? std::string(reinterpret_cast<const char*>(text)) : std::string();
+}
+
+bool SqlStatement::IsNull(int column) const {
+  return sqlite3_column_type(impl_->statement, column) == SQLITE_NULL;
+}
+
+const void* SqlStatement::Blob(int column, size_t* size) const {
+  const void* data = sqlite3_column_blob(impl_->statement, column);
+  *size = static_cast<size_t>(sqlite3_column_bytes(impl_->statement, column));
+  return data;
+}
+
+SqlTransaction::SqlTransaction(SqlConnection& connection, Kind kind) : connection_(connection) {
+  connection_.Execute(kind == Kind::kWrite ? "BEGIN IMMEDIATE" : "BEGIN");
+}
+
+SqlTransaction::~SqlTransaction() {
+  if (open_) connection_.RollbackIfActive();
+}
+
+void SqlTransaction::Commit() {
+  connection_.Execute("COMMIT");
+  open_ = false;
+}
+
+}  // namespace ecv

@@ -1,0 +1,289 @@
+// The model database on synthetic models (no rendering): storing and loading bit for bit, atomic replacement,
+// removal, colour matrices, feature settings, verification, bad files, schema versions and migration.
+
+#include <fstream>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "core/error.h"
+#include "modeldb/content_hash.h"
+#include "modeldb/model_database.h"
+#include "modeldb/schema.h"
+#include "modeldb/sql.h"
+#include "modeldb_test_util.h"
+#include "support/test_data.h"
+
+namespace ecv {
+namespace {
+
+using ::testing::AllOf;
+using ::testing::Contains;
+using ::testing::HasSubstr;
+
+// The message of the InputError thrown by `action`, or "" when none is thrown.
+template <typename Action>
+std::string InputErrorOf(Action action) {
+  try {
+    action();
+  } catch (const InputError& error) {
+    return error.what();
+  }
+  return "";
+}
+
+TEST(ContentHash, MatchesTheStandardTestVectors) {
+  EXPECT_EQ(Sha256Hex("", 0), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+  EXPECT_EQ(Sha256Hex("abc", 3), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  const std::string two_blocks = "abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq";
+  EXPECT_EQ(Sha256Hex(two_blocks.data(), two_blocks.size()),
+            "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1");
+  Sha256 pieces;  // the same bytes in uneven pieces
+  pieces.Update(two_blocks.data(), 5);
+  pieces.Update(two_blocks.data() + 5, two_blocks.size() - 5);
+  EXPECT_EQ(pieces.HexDigest(), Sha256Hex(two_blocks.data(), two_blocks.size()));
+}
+
+TEST(ModelDatabase, StoresAndLoadsModelsBitForBit) {
+  ModelDatabase database(":memory:", OpenMode::kCreate);
+  const ModelRecord a = test::SyntheticModel("a", 3, 200, 1);
+  const ModelRecord b = test::SyntheticModel("b", 2, 150, 2);
+  database.AddModel(a);
+  database.AddModel(b);
+  const std::vector<StoredModel> loaded = database.LoadModels();
+  ASSERT_EQ(loaded.size(), 2U);
+  for (const auto& [expected, stored] : {std::pair(&a, &loaded[0]), std::pair(&b, &loaded[1])}) {
+    EXPECT_EQ(stored->record.name, expected->name);
+    EXPECT_EQ(test::CompareViews(expected->views, stored->record.views), "") << expected->name;
+    EXPECT_EQ(stored->record.DescriptorSha256(), expected->DescriptorSha256());
+    EXPECT_TRUE(stored->record.object_from_mesh.isApprox(expected->object_from_mesh, 0.0));
+    EXPECT_EQ(stored->record.diameter_m, expected->diameter_m);
+  }
+  const ModelSummary summary = database.FindModel("a").value();
+  EXPECT_EQ(summary.num_views, 3);
+  EXPECT_EQ(summary.num_primitives, 600);
+  EXPECT_EQ(summary.num_descriptors, a.NumDescriptors());
+  EXPECT_EQ(summary.descriptor_sha256, a.DescriptorSha256());
+  EXPECT_FALSE(summary.symmetric);
+  EXPECT_FALSE(database.FindModel("c").has_value());
+}
+
+TEST(ModelDatabase, ReplacesAModelOfTheSameNameWhole) {
+  ModelDatabase database(":memory:", OpenMode::kCreate);
+  database.AddModel(test::SyntheticModel("a", 3, 100, 1));
+  database.AddModel(test::SyntheticModel("b", 2, 100, 2));
+  const ModelRecord replacement = test::SyntheticModel("a", 5, 80, 3);
+  const AddModelResult result = database.AddModel(replacement);
+  EXPECT_TRUE(result.replaced);
+  ASSERT_EQ(database.ListModels().size(), 2U);
+  const std::vector<StoredModel> loaded = database.LoadModels({"a"});
+  EXPECT_EQ(test::CompareViews(replacement.views, loaded.at(0).record.views), "");
+  const VerifyReport report = database.Verify();
+  EXPECT_TRUE(report.ok()) << report.problems.front();
+  EXPECT_EQ(report.views, 5 + 2);  // nothing of the old "a" is left
+  EXPECT_EQ(report.primitives, 5 * 80 + 2 * 100);
+}
+
+TEST(ModelDatabase, RemovesAModelWithItsRows) {
+  ModelDatabase database(":memory:", OpenMode::kCreate);
+  database.AddModel(test::SyntheticModel("a", 3, 100, 1));
+  database.AddModel(test::SyntheticModel("b", 2, 100, 2));
+  database.SetColorMatrix("a", {Eigen::Matrix3d::Identity() * 0.9, 0.01, "test", ""});
+  EXPECT_TRUE(database.RemoveModel("a"));
+  EXPECT_FALSE(database.RemoveModel("a"));
+  ASSERT_EQ(database.ListModels().size(), 1U);
+  EXPECT_EQ(database.ListModels()[0].name, "b");
+  const VerifyReport report = database.Verify();
+  EXPECT_TRUE(report.ok());
+  EXPECT_EQ(report.views, 2);
+  EXPECT_EQ(report.primitives, 200);
+  EXPECT_EQ(report.descriptors, 2 * 80);
+}
+
+TEST(ModelDatabase, KeepsAColourMatrixAcrossARebuildOfTheSameMeshOnly) {
+  ModelDatabase database(":memory:", OpenMode::kCreate);
+  ModelRecord model = test::SyntheticModel("a", 2, 50, 1);
+  database.AddModel(model);
+  EXPECT_FALSE(database.GetColorMatrix("a").has_value());
+  ColorMatrixRecord matrix;
+  matrix.model_to_scene << 0.9, 0.1, 0.0, 0.05, 1.1, -0.02, 0.0, 0.0, 0.8;
+  matrix.rms = 0.012;
+  matrix.source = "pairs:pairs.csv";
+  database.SetColorMatrix("a", matrix);
+  const ColorMatrixRecord stored = database.GetColorMatrix("a").value();
+  EXPECT_EQ(stored.model_to_scene, matrix.model_to_scene);
+  EXPECT_EQ(stored.rms, 0.012);
+  EXPECT_EQ(stored.source, "pairs:pairs.csv");
+  EXPECT_FALSE(stored.created.empty());
+  EXPECT_TRUE(database.FindModel("a")->has_color_matrix);
+
+  EXPECT_TRUE(database.AddModel(model).color_matrix_kept);  // same mesh content
+  EXPECT_EQ(database.GetColorMatrix("a")->model_to_scene, matrix.model_to_scene);
+  model.mesh_sha256 = std::string(64, 'f');
+  EXPECT_TRUE(database.AddModel(model).color_matrix_dropped);  // another mesh: the fit no longer holds
+  EXPECT_FALSE(database.GetColorMatrix("a").has_value());
+
+  database.SetColorMatrix("a", matrix);
+  EXPECT_TRUE(database.ClearColorMatrix("a"));
+  EXPECT_FALSE(database.ClearColorMatrix("a"));
+  matrix.model_to_scene(1, 1) = std::nan("");
+  EXPECT_THAT(InputErrorOf([&] { database.SetColorMatrix("a", matrix); }), HasSubstr("finite"));
+  EXPECT_THAT(InputErrorOf([&] { database.GetColorMatrix("nope"); }), AllOf(HasSubstr("nope"), HasSubstr("(a)")));
+}
+
+TEST(ModelDatabase, SetsTheSymmetryFlag) {
+  ModelDatabase database(":memory:", OpenMode::kCreate);
+  database.AddModel(test::SyntheticModel("a", 1, 10, 1));
+  database.SetSymmetric("a", true);
+  EXPECT_TRUE(database.FindModel("a")->symmetric);
+  EXPECT_TRUE(database.LoadModels({"a"}).at(0).record.symmetric);
+  EXPECT_THAT(InputErrorOf([&] { database.SetSymmetric("b", true); }), HasSubstr("\"b\""));
+}
+
+TEST(ModelDatabase, KeepsOneSetOfFeatureSettingsPerLibrary) {
+  ModelDatabase database(":memory:", OpenMode::kCreate);
+  EXPECT_FALSE(database.feature_settings().has_value());
+  ModelRecord a = test::SyntheticModel("a", 1, 10, 1);
+  a.features.descriptor.soft_binning = false;
+  database.AddModel(a);
+  EXPECT_FALSE(database.feature_settings()->descriptor.soft_binning);
+  ModelRecord b = test::SyntheticModel("b", 1, 10, 2);  // default settings: soft binning
+  EXPECT_THAT(InputErrorOf([&] { database.AddModel(b); }), AllOf(HasSubstr("feature settings"), HasSubstr("\"b\"")));
+  EXPECT_EQ(database.ListModels().size(), 1U);
+  database.AddModel(test::SyntheticModel("a", 1, 10, 3));  // replacing the only model may change them
+  EXPECT_TRUE(database.feature_settings()->descriptor.soft_binning);
+  EXPECT_TRUE(database.LoadModels().at(0).record.features.descriptor.soft_binning);
+}
+
+TEST(ModelDatabase, RefusesIncompleteRecords) {
+  ModelDatabase database(":memory:", OpenMode::kCreate);
+  EXPECT_THAT(InputErrorOf([&] { database.AddModel(test::SyntheticModel("", 1, 10, 1)); }), HasSubstr("name"));
+  EXPECT_THAT(InputErrorOf([&] { database.AddModel(test::SyntheticModel("a", 0, 10, 1)); }), HasSubstr("view"));
+  ModelRecord broken = test::SyntheticModel("a", 1, 10, 1);
+  broken.views[0].descriptors.primitive[0] = 99;
+  EXPECT_THAT(InputErrorOf([&] { database.AddModel(broken); }), HasSubstr("refer to its primitives"));
+  EXPECT_TRUE(database.ListModels().empty());
+}
+
+TEST(ModelDatabase, VerifyFindsChangedDescriptorsAndOrphans) {
+  test::TemporaryDirectory directory;
+  const std::string path = directory.File("lib.sqlite");
+  {
+    ModelDatabase database(path, OpenMode::kCreate);
+    database.AddModel(test::SyntheticModel("a", 2, 50, 1));
+    EXPECT_TRUE(database.Verify().ok());
+  }
+  {
+    SqlConnection raw(path, SqlOpenMode::kReadWrite, 1000);
+    raw.Execute(
+        "UPDATE descriptors SET value = zeroblob(384) WHERE primitive_id = (SELECT min(primitive_id) "
+        "FROM descriptors)");
+  }
+  VerifyReport report = ModelDatabase(path, OpenMode::kReadOnly).Verify();
+  EXPECT_THAT(report.problems, Contains(HasSubstr("descriptor values differ")));
+  EXPECT_TRUE(ModelDatabase(path, OpenMode::kReadOnly).Verify(false).ok());  // the quick check cannot see it
+  {
+    SqlConnection raw(path, SqlOpenMode::kReadWrite, 1000);  // foreign keys are off in a raw connection
+    raw.Execute("DELETE FROM views WHERE view_index = 1");
+  }
+  report = ModelDatabase(path, OpenMode::kReadOnly).Verify();
+  EXPECT_THAT(report.problems, Contains(HasSubstr("foreign key: primitives")));
+  EXPECT_THAT(report.problems, Contains(HasSubstr("2 views stored, 1 present")));
+}
+
+TEST(ModelDatabase, NamesWhatIsWrongWithABadFile) {
+  test::TemporaryDirectory directory;
+  const std::string text = directory.File("notes.sqlite");
+  std::ofstream(text) << "not a database, just text that is long enough to have a header\n";
+  EXPECT_THAT(InputErrorOf([&] { ModelDatabase(text, OpenMode::kReadOnly); }),
+              AllOf(HasSubstr(text), HasSubstr("not an SQLite database")));
+  EXPECT_THAT(InputErrorOf([&] { ModelDatabase(text, OpenMode::kCreate); }), HasSubstr("not an SQLite database"));
+
+  const std::string missing = directory.File("missing.sqlite");
+  EXPECT_THAT(InputErrorOf([&] { ModelDatabase(missing, OpenMode::kReadOnly); }),
+              AllOf(HasSubstr("no such model library"), HasSubstr("ecvpose modeldb build")));
+  EXPECT_THAT(InputErrorOf([&] { ModelDatabase(directory.File("no/such/dir/lib.sqlite"), OpenMode::kCreate); }),
+              HasSubstr("existing directory"));
+
+  const std::string foreign = directory.File("foreign.sqlite");
+  SqlConnection(foreign, SqlOpenMode::kCreate, 1000).Execute("CREATE TABLE photos (id INTEGER)");
+  EXPECT_THAT(InputErrorOf([&] { ModelDatabase(foreign, OpenMode::kCreate); }),
+              AllOf(HasSubstr("not an ecvpose model library"), HasSubstr("photos")));
+
+  const std::string empty = directory.File("empty.sqlite");
+  std::ofstream{empty};
+  EXPECT_THAT(InputErrorOf([&] { ModelDatabase(empty, OpenMode::kReadOnly); }), HasSubstr("empty database"));
+  EXPECT_EQ(InputErrorOf([&] { ModelDatabase(empty, OpenMode::kCreate).AddModel(test::SyntheticModel("a", 1, 5, 1)); }),
+            "");
+}
+
+TEST(ModelDatabase, RefusesANewerSchemaNamingTheVersionNeeded) {
+  test::TemporaryDirectory directory;
+  const std::string path = directory.File("lib.sqlite");
+  ModelDatabase(path, OpenMode::kCreate).AddModel(test::SyntheticModel("a", 1, 10, 1));
+  {
+    SqlConnection raw(path, SqlOpenMode::kReadWrite, 1000);
+    raw.Execute("PRAGMA user_version = 7; UPDATE meta SET value = '0.9.0' WHERE key = 'min_ecvpose_version'");
+  }
+  for (const OpenMode mode : {OpenMode::kReadOnly, OpenMode::kReadWrite, OpenMode::kCreate}) {
+    EXPECT_THAT(InputErrorOf([&] { ModelDatabase(path, mode); }),
+                AllOf(HasSubstr(path), HasSubstr("schema version 7"), HasSubstr("up to 1"),
+                      HasSubstr("ecvpose 0.9.0 or newer")));
+  }
+  EXPECT_THAT(InputErrorOf([&] { MigrateModelDatabase(path); }), HasSubstr("schema version 7"));
+}
+
+TEST(ModelDatabase, MigratesThePrototypeLayoutInOneStep) {
+  test::TemporaryDirectory directory;
+  const std::string path = directory.File("old.sqlite");
+  const ModelRecord a = test::SyntheticModel("a", 2, 60, 1);
+  const ModelRecord b = test::SyntheticModel("b", 3, 40, 2);
+  test::WritePrototypeLibrary(path, {a, b});
+  EXPECT_THAT(InputErrorOf([&] { ModelDatabase(path, OpenMode::kReadOnly); }),
+              AllOf(HasSubstr("schema version 0"), HasSubstr("ecvpose modeldb migrate --db " + path)));
+  EXPECT_THAT(InputErrorOf([&] { ModelDatabase(path, OpenMode::kCreate); }), HasSubstr("modeldb migrate"));
+
+  const ModelDbMigration migration = MigrateModelDatabase(path);
+  EXPECT_EQ(migration.from_version, 0);
+  EXPECT_EQ(migration.to_version, kModelDbSchemaVersion);
+  EXPECT_EQ(migration.steps.size(), 1U);
+  EXPECT_TRUE(MigrateModelDatabase(path).steps.empty());  // nothing left to do
+
+  ModelDatabase database(path, OpenMode::kReadWrite);
+  const VerifyReport report = database.Verify();
+  EXPECT_TRUE(report.ok()) << (report.ok() ? "" : report.problems.front());
+  const std::vector<StoredModel> loaded = database.LoadModels();
+  ASSERT_EQ(loaded.size(), 2U);
+  EXPECT_EQ(test::CompareViews(a.views, loaded[0].record.views), "");
+  EXPECT_EQ(test::CompareViews(b.views, loaded[1].record.views), "");
+  const ModelSummary summary = database.FindModel("b").value();
+  EXPECT_EQ(summary.num_views, 3);
+  EXPECT_EQ(summary.num_descriptors, b.NumDescriptors());
+  EXPECT_EQ(summary.descriptor_sha256, b.DescriptorSha256());
+  EXPECT_FALSE(summary.symmetric);
+  database.SetColorMatrix("a", {});  // the tables of version 1 are there
+  database.AddModel(test::SyntheticModel("c", 1, 10, 3));
+  EXPECT_EQ(database.ListModels().size(), 3U);
+}
+
+TEST(ModelDatabase, AFailedMigrationLeavesTheOldFileAsItWas) {
+  test::TemporaryDirectory directory;
+  const std::string path = directory.File("old.sqlite");
+  test::WritePrototypeLibrary(path, {test::SyntheticModel("a", 2, 30, 1)});
+  {
+    SqlConnection raw(path, SqlOpenMode::kReadWrite, 1000);  // a view whose model is gone: the check fails
+    raw.Execute("INSERT INTO views VALUES (NULL, 99, 0, 1, 1, 1, 1, 1, 1, '[]')");
+  }
+  EXPECT_THAT(InputErrorOf([&] { MigrateModelDatabase(path); }), HasSubstr("foreign keys"));
+  SqlConnection raw(path, SqlOpenMode::kReadOnly, 1000);
+  const SchemaState state = InspectSchema(raw);
+  EXPECT_EQ(state.kind, SchemaState::Kind::kOlder);
+  EXPECT_EQ(state.version, 0);
+  SqlStatement settings = raw.Prepare("SELECT count(*) FROM settings");
+  ASSERT_TRUE(settings.Step());
+  EXPECT_EQ(settings.Int(0), 1);  // the prototype's tables are still there
+}
+
+}  // namespace
+}  // namespace ecv
