@@ -311,8 +311,8 @@ std::vector<Variant> Variants() {
   add("shape only (no colour histograms)", [](Variant& v) { v.descriptor.use_color = false; });
   add("radius 0.015 m", [](Variant& v) { v.descriptor.radius_m = 0.015; });
   add("radius 0.035 m", [](Variant& v) { v.descriptor.radius_m = 0.035; });
-  add("at most 24 neighbours", [](Variant& v) { v.descriptor.max_neighbours = 24; });
-  add("at most 48 neighbours", [](Variant& v) { v.descriptor.max_neighbours = 48; });
+  add("at most 32 neighbours (spread)", [](Variant& v) { v.descriptor.max_neighbours = 32; });
+  add("at most 64 neighbours (spread)", [](Variant& v) { v.descriptor.max_neighbours = 64; });
   add("wavelength 6 px", [](Variant& v) { v.extraction.monogenic.wavelength_px = 6; });
   add("wavelength 8 px", [](Variant& v) { v.extraction.monogenic.wavelength_px = 8; });
   add("wavelength 16 px", [](Variant& v) { v.extraction.monogenic.wavelength_px = 16; });

@@ -1,7 +1,7 @@
 # Every dependency comes from Debian 12's packages (see scripts/setup).
 
 find_package(Eigen3 3.3 REQUIRED NO_MODULE)
-find_package(OpenCV 4 REQUIRED COMPONENTS core imgproc imgcodecs features2d)
+find_package(OpenCV 4 REQUIRED COMPONENTS core imgproc imgcodecs features2d flann)
 find_package(assimp REQUIRED)
 find_package(PCL 1.12 REQUIRED COMPONENTS common io)
 find_package(nlohmann_json 3 REQUIRED)

@@ -110,11 +110,16 @@ Descriptors ComputeDescriptors(const std::vector<Primitive>& input, const Descri
   cv::Mat values(static_cast<int>(primitives.size()), kDescriptorSize, CV_32F);
   std::vector<int> neighbours;
   for (size_t i = 0; i < primitives.size(); ++i) {
-    if (neighbour_lists[i].size() < 2) continue;  // isolated: no context
-    const size_t kept = options.max_neighbours > 0
-                            ? std::min<size_t>(neighbour_lists[i].size(), static_cast<size_t>(options.max_neighbours))
-                            : neighbour_lists[i].size();
-    neighbours.assign(neighbour_lists[i].begin(), neighbour_lists[i].begin() + static_cast<long>(kept));
+    if (neighbour_lists[i].size() < 2) continue;            // isolated: no context
+    const std::vector<size_t>& found = neighbour_lists[i];  // by distance, the source first
+    const size_t cap = options.max_neighbours > 0 ? static_cast<size_t>(options.max_neighbours) : found.size();
+    neighbours.clear();
+    if (found.size() <= cap) {
+      neighbours.assign(found.begin(), found.end());
+    } else {  // evenly spread over the distance ranks, so that the context still spans the whole radius
+      for (size_t j = 0; j < cap; ++j)
+        neighbours.push_back(static_cast<int>(found[j * (found.size() - 1) / (cap - 1)]));
+    }
     float* row = values.ptr<float>(static_cast<int>(descriptors.primitive.size()));
     DescribeContext(primitives, neighbours, options, row);
     descriptors.primitive.push_back(static_cast<int>(i));

@@ -17,8 +17,9 @@ inline constexpr int kDescriptorSize = 6 * kDescriptorBins;
 /// descriptor is soft_binning = false, hellinger = false.
 struct DescriptorOptions {
   double radius_m = 0.025;  ///< context radius around each primitive, metres
-  /// Context = at most this many primitives nearest to the source (itself included); 0 = all within
-  /// the radius, as in the paper. Pairs grow with its square: the cap bounds the cost in dense views.
+  /// Context = at most this many of the primitives within the radius (the source included), spread evenly
+  /// over their distance ranks so that the context still spans the radius; 0 = all, as in the paper.
+  /// Pairs grow with its square: the cap bounds the cost in dense views.
   int max_neighbours = 0;
   bool unsigned_segments = false;  ///< a segment's direction has no sign: use |cosines| that involve one
   bool soft_binning = true;        ///< share each value between its two nearest bins (linear)

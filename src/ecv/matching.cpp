@@ -1,22 +1,24 @@
 #include "ecv/matching.h"
 
 #include <cmath>
+#include <cstdlib>
+#include <mutex>
 #include <string>
 
-#include <flann/algorithms/dist.h>
-#include <flann/algorithms/kdtree_index.h>
-#include <flann/algorithms/linear_index.h>
+#include <opencv2/flann.hpp>
 
 #include "core/error.h"
 #include "core/point_index.h"
 
 namespace ecv {
 
-// One FLANN index over the train descriptors of one type (or of all), with the rows' primitive indices.
+// One FLANN index (OpenCV's) over the train descriptors of one type (or of all), with the rows' primitive
+// indices. OpenCV's copy of FLANN is used because its randomised kd-trees draw from seedable generators;
+// Debian's libflann shuffles them with std::random_device, so its matches differ from run to run.
 struct DescriptorMatcher::Index {
   cv::Mat values;              // owned copy: FLANN keeps pointers into it
   std::vector<int> primitive;  // train primitive of each row
-  std::unique_ptr<flann::NNIndex<flann::L2<float>>> index;
+  std::unique_ptr<cv::flann::Index> index;
 };
 
 namespace {
@@ -34,10 +36,6 @@ void SelectRows(const Descriptors& descriptors, Keep keep, cv::Mat* values, std:
     descriptors.values.row(rows[i]).copyTo(values->row(static_cast<int>(i)));
     primitive->push_back(descriptors.primitive[static_cast<size_t>(rows[i])]);
   }
-}
-
-flann::Matrix<float> AsFlann(const cv::Mat& values) {
-  return {const_cast<float*>(values.ptr<float>()), static_cast<size_t>(values.rows), static_cast<size_t>(values.cols)};
 }
 
 }  // namespace
@@ -59,14 +57,19 @@ DescriptorMatcher::DescriptorMatcher(const std::vector<Primitive>& train_primiti
         [&](int i) { return types == 1 || static_cast<int>(train_primitives[static_cast<size_t>(i)].type) == type; },
         &index->values, &index->primitive);
     if (index->values.rows > 0) {
-      const flann::Matrix<float> data = AsFlann(index->values);
+      // The trees draw from std::rand and OpenCV's generator: both seeded, under a lock, so that the same
+      // descriptors always give the same trees (and the same matches).
+      static std::mutex seed_mutex;
+      const std::lock_guard<std::mutex> lock(seed_mutex);
+      std::srand(1);
+      cv::theRNG().state = 1;
       if (index->values.rows < options_.exact_below) {
-        index->index = std::make_unique<flann::LinearIndex<flann::L2<float>>>(data);
-      } else {
         index->index =
-            std::make_unique<flann::KDTreeIndex<flann::L2<float>>>(data, flann::KDTreeIndexParams(options_.trees));
+            std::make_unique<cv::flann::Index>(index->values, cv::flann::LinearIndexParams(), cvflann::FLANN_DIST_L2);
+      } else {
+        index->index = std::make_unique<cv::flann::Index>(index->values, cv::flann::KDTreeIndexParams(options_.trees),
+                                                          cvflann::FLANN_DIST_L2);
       }
-      index->index->buildIndex();
     }
     indices_.push_back(std::move(index));
   }
@@ -90,15 +93,14 @@ std::vector<DescriptorMatch> DescriptorMatcher::Match(const std::vector<Primitiv
         &values, &primitive);
     if (values.rows == 0) continue;
     const int k = std::min(options_.k, index.values.rows);
-    std::vector<std::vector<size_t>> neighbours;
-    std::vector<std::vector<float>> squared;
-    flann::SearchParams search(options_.checks);
-    search.sorted = true;
-    index.index->knnSearch(AsFlann(values), neighbours, squared, static_cast<size_t>(k), search);
-    for (size_t q = 0; q < neighbours.size(); ++q) {
-      for (size_t rank = 0; rank < neighbours[q].size(); ++rank) {
-        matches.push_back(
-            {primitive[q], index.primitive[neighbours[q][rank]], std::sqrt(squared[q][rank]), static_cast<int>(rank)});
+    cv::Mat neighbours, squared;
+    index.index->knnSearch(values, neighbours, squared, k, cv::flann::SearchParams(options_.checks));
+    for (int q = 0; q < neighbours.rows; ++q) {
+      for (int rank = 0; rank < k; ++rank) {
+        const int train = neighbours.at<int>(q, rank);
+        if (train < 0) continue;
+        matches.push_back({primitive[static_cast<size_t>(q)], index.primitive[static_cast<size_t>(train)],
+                           std::sqrt(squared.at<float>(q, rank)), rank});
       }
     }
   }

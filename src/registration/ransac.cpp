@@ -84,6 +84,7 @@ class Estimator {
   }
 
   struct Best {
+    double agreeing = 0.0;  // share of agreeing correspondences (ranks poses first when prefer_agreeing)
     double error = std::numeric_limits<double>::max();
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
     size_t inliers = 0, visible = 0;
@@ -94,6 +95,12 @@ class Estimator {
     double agreeing = 0.0;  // largest share of agreeing correspondences of an accepted pose
     bool stopped_early = false;
   };
+
+  // The ranking of accepted poses: more agreeing correspondences first (when preferred; 0 otherwise), then
+  // the lower mean fit error.
+  static bool Better(const Best& a, const Best& b) {
+    return a.agreeing > b.agreeing || (a.agreeing == b.agreeing && a.error < b.error);
+  }
 
   // Share of the correspondences whose object point lands within eps of its scene point under `pose`.
   double AgreeingShare(const Eigen::Isometry3d& pose) const {
@@ -132,9 +139,12 @@ class Estimator {
       // Re-estimate on the inliers; the fit error is that of the same inlier pairs under the new pose.
       if (!FitRigid(inliers.object, inliers.scene, &pose)) continue;
       const double error = MeanPairDistance(pose, inliers);
-      if (options_.adaptive) outcome.agreeing = std::max(outcome.agreeing, AgreeingShare(pose));
-      if (error < outcome.best.error) {
-        outcome.best = {error, pose, inliers.object.size(), inliers.visible};
+      const double agreeing = options_.adaptive || options_.prefer_agreeing ? AgreeingShare(pose) : 0.0;
+      outcome.agreeing = std::max(outcome.agreeing, agreeing);
+      const Best candidate{options_.prefer_agreeing ? agreeing : 0.0, error, pose, inliers.object.size(),
+                           inliers.visible};
+      if (Better(candidate, outcome.best)) {
+        outcome.best = candidate;
         if (options_.early_stop_fit_error_m > 0.0 && error < options_.early_stop_fit_error_m) {
           outcome.stopped_early = true;
           break;
@@ -301,13 +311,13 @@ RansacResult EstimatePoseRansac(const std::vector<Eigen::Vector3f>& object_point
     const Estimator::BlockOutcome& outcome = outcomes[static_cast<size_t>(block)];
     result.iterations += outcome.iterations;
     result.rejected_by_polygon += outcome.rejected_by_polygon;
-    if (outcome.best.error < best.error) best = outcome.best;
+    if (Estimator::Better(outcome.best, best)) best = outcome.best;
   }
   if (best.inliers > 0) result.correspondence_inlier_ratio = estimator.AgreeingShare(best.pose);
   if (best.inliers > 0) {
     result.success = true;
     result.scene_from_object = best.pose;
-    result.fit_error_m = best.error;
+    result.fit_error_m = best.error;  // (the pose with the most agreeing correspondences, when preferred)
     result.inlier_fraction = static_cast<double>(best.inliers) / static_cast<double>(best.visible);
     result.visible_fraction = static_cast<double>(best.visible) / static_cast<double>(object_points.size());
   }

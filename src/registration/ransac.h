@@ -30,6 +30,10 @@ struct RansacOptions {
   /// Beyond the paper: the iteration count is lowered as accepted poses show a larger share w of agreeing
   /// correspondences (k = log(1 - p) / log(1 - w^n), w from the best pose so far, at most Iterations()).
   bool adaptive = false;
+  /// Beyond the paper: of the accepted poses keep the one with the most agreeing correspondences (ties: the
+  /// lower fit error) instead of the lowest fit error. The correspondences carry appearance, so this tells a
+  /// box from the same box turned over, which fit the scene's shape equally well.
+  bool prefer_agreeing = false;
   uint64_t seed = 1;  ///< same seed, same result (whatever the number of threads)
   int threads = 1;    ///< worker threads; the result does not depend on it
   /// Beyond the paper: object points are checked in a fixed random order and a hypothesis is dropped once
