@@ -27,5 +27,8 @@ CommandAction SetupFeaturesCommand(CLI::App& command);
 CommandAction SetupRenderCommand(CLI::App& command);   // render/render_command.cpp
 CommandAction SetupModeldbCommand(CLI::App& command);  // modeldb/modeldb_command.cpp
 CommandAction SetupRegisterCommand(CLI::App& command);
+CommandAction SetupColorcalCommand(CLI::App& command);   // colorcal/colorcal_command.cpp
+CommandAction SetupRecognizeCommand(CLI::App& command);  // recognize/recognize_command.cpp
+CommandAction SetupEvalCommand(CLI::App& command);       // recognize/eval_command.cpp
 
 }  // namespace ecv::app

@@ -22,8 +22,14 @@ const Subcommand kSubcommands[] = {
      ecv::app::SetupRenderCommand},
     {"modeldb", "Build the model library (SQLite) from meshes; list, info, remove, verify, export",
      ecv::app::SetupModeldbCommand},
+    {"colorcal", "Fit a model's colour matrix from pairs or a frame with a known pose; show, clear",
+     ecv::app::SetupColorcalCommand},
     {"register", "Align two views of a scene (ECV context + prerejective RANSAC + ICP); writes b_from_a",
      ecv::app::SetupRegisterCommand},
+    {"recognize", "Find the library's objects with their 6D poses in RGB-D frames; JSON and a picture",
+     ecv::app::SetupRecognizeCommand},
+    {"eval", "Score detections against ground truth: rotation, translation, ADD, ADD-S, recall",
+     ecv::app::SetupEvalCommand},
 };
 
 }  // namespace

@@ -1,0 +1,238 @@
+// `ecvpose recognize --db lib.sqlite FRAME`: finds the library's objects in an RGB-D frame.
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "app/commands.h"
+#include "app/frame_args.h"
+#include "core/error.h"
+#include "core/pose.h"
+#include "io/frame_io.h"
+#include "io/pose_io.h"
+#include "modeldb/model_library.h"
+#include "recognize/recognizer.h"
+
+namespace ecv::app {
+namespace {
+
+struct RecognizeArgs {
+  std::string db;
+  std::vector<std::string> models;
+  FrameSpec frame;
+  std::string sequence;
+  RecognizerOptions options;
+  std::string out_json;
+  std::string out_bop;
+  int scene_id = -1, image_id = -1;
+  std::string overlay;
+};
+
+// The frames of --sequence: a directory of YCB-Video frames (*-color.png) or frame JSONs, in name order, or
+// a text file with one FRAME per line ('#' starts a comment).
+std::vector<std::string> SequenceFrames(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> frames;
+  if (fs::is_directory(path)) {
+    for (const auto& entry : fs::directory_iterator(path)) {
+      const std::string name = entry.path().string();
+      const std::string suffix = "-color.png";
+      if (name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0) {
+        frames.push_back(name.substr(0, name.size() - suffix.size()));
+      } else if (entry.path().extension() == ".json") {
+        frames.push_back(name);
+      }
+    }
+    std::sort(frames.begin(), frames.end());
+  } else {
+    std::ifstream in(path);
+    if (!in) ThrowInputError(path, "sequence", "a directory of frames or a text file with one FRAME per line");
+    for (std::string line; std::getline(in, line);) {
+      line = line.substr(0, line.find('#'));
+      line.erase(0, line.find_first_not_of(" \t\r"));
+      line.erase(line.find_last_not_of(" \t\r") + 1);
+      if (!line.empty()) frames.push_back(line);
+    }
+  }
+  if (frames.empty()) ThrowInputError(path, "sequence", "at least one frame (*-color.png, *.json, or lines)");
+  return frames;
+}
+
+// BOP object id of a model: the number in "obj_000005", or the YCB-Video class index of "003_cracker_box".
+int BopObjectId(const std::string& model) {
+  if (model.rfind("obj_", 0) == 0) return std::stoi(model.substr(4));
+  for (int id = 1; id <= 21; ++id) {
+    if (YcbvClassName(id) == model) return id;
+  }
+  ThrowInputError(model, "model name", "obj_NNNNNN or a YCB-Video class name, for the BOP obj_id");
+}
+
+// Scene and image ids of a frame: from the flags, or from a YCB-Video prefix ".../0001/000007" or a BOP
+// image "SCENE_DIR:ID".
+std::pair<int, int> BopIds(const std::string& frame, int scene_id, int image_id) {
+  namespace fs = std::filesystem;
+  if (scene_id >= 0 && image_id >= 0) return {scene_id, image_id};
+  const size_t colon = frame.rfind(':');
+  try {
+    if (colon != std::string::npos) {
+      return {std::stoi(fs::path(frame.substr(0, colon)).filename().string()), std::stoi(frame.substr(colon + 1))};
+    }
+    return {std::stoi(fs::path(frame).parent_path().filename().string()),
+            std::stoi(fs::path(frame).filename().string())};
+  } catch (const std::exception&) {
+    ThrowInputError(frame, "scene and image ids", "--scene-id and --image-id, or a YCB-Video or BOP frame name");
+  }
+}
+
+// One BOP CSV row per detection: scene_id,im_id,obj_id,score,R (9, row-major),t (mm),time (s).
+void AppendBopRows(std::ostream& out, int scene_id, int image_id, const RecognitionResult& result) {
+  for (const Detection& d : result.detections) {
+    const Eigen::Matrix3d r = d.camera_from_object.linear();
+    const Eigen::Vector3d t = d.camera_from_object.translation() * 1000.0;
+    out << scene_id << ',' << image_id << ',' << BopObjectId(d.model) << ',' << d.score << ',';
+    for (int i = 0; i < 9; ++i) out << (i > 0 ? " " : "") << r(i / 3, i % 3);
+    out << ',' << t.x() << ' ' << t.y() << ' ' << t.z() << ',' << result.timings_ms.at("total") / 1000.0 << '\n';
+  }
+}
+
+void PrintDetections(const LoadedFrame& loaded, const RecognitionResult& result) {
+  std::cout << std::fixed << std::setprecision(2) << loaded.rgbd.name << ": " << result.detections.size()
+            << " detections (" << result.scene_primitives << " scene primitives)\n";
+  for (const Detection& d : result.detections) {
+    std::cout << "  " << std::left << std::setw(24) << d.model << std::right << " score " << d.score << " (depth "
+              << d.depth_agreement << ", colour " << d.color_agreement << "), inliers " << d.inlier_fraction
+              << ", view " << d.view << ", t = [" << std::setprecision(3)
+              << d.camera_from_object.translation().transpose() << "] m" << std::setprecision(2) << '\n';
+    for (const GroundTruth& truth : loaded.ground_truth) {
+      if (truth.object_name != d.model) continue;
+      std::cout << "    vs ground truth: " << std::setprecision(1)
+                << TranslationDistance(d.camera_from_object, truth.camera_from_object) * 1000.0 << " mm, "
+                << RotationAngle(d.camera_from_object, truth.camera_from_object) * 180.0 / M_PI << " deg\n"
+                << std::setprecision(2);
+    }
+  }
+  std::cout << "time:" << std::setprecision(1);
+  for (const auto& [stage, ms] : result.timings_ms) std::cout << ' ' << stage << ' ' << ms << " ms";
+  std::cout << '\n';
+}
+
+// Writes `text` to `path` through a temporary file, so that a failed run leaves no half-written output.
+void WriteTextAtomically(const std::string& path, const std::string& text) {
+  const std::string temporary = path + ".tmp";
+  {
+    std::ofstream out(temporary);
+    out << text;
+    if (!out) ThrowInputError(path, "output", "a writable file");
+  }
+  std::filesystem::rename(temporary, path);
+}
+
+int RunRecognize(const RecognizeArgs& args) {
+  args.options.Check();
+  if (!args.sequence.empty() && (!args.frame.positional.empty() || args.frame.color_path.size() > 0)) {
+    ThrowInputError("recognize", "--sequence", "either a sequence or one frame, not both");
+  }
+  if (!args.sequence.empty() && !args.overlay.empty()) {
+    ThrowInputError("recognize", "--overlay", "one frame (not with --sequence)");
+  }
+  std::vector<std::string> frames;
+  if (!args.sequence.empty()) frames = SequenceFrames(args.sequence);
+  LibraryLoadOptions load;
+  load.names = args.models;
+  load.build_matchers = false;  // the scene is indexed, the views are queried
+  const ModelLibrary library = ModelLibrary::Load(args.db, load);
+  std::cerr << "recognize: " << library.models().size() << " models, " << library.NumViews() << " views from "
+            << args.db << " (" << std::fixed << std::setprecision(0) << library.timings().read_ms << " ms)\n";
+  Recognizer recognizer(library, args.options);
+
+  if (frames.empty()) {  // one frame
+    const LoadedFrame loaded = LoadFrame(args.frame);
+    const RecognitionResult result = recognizer.Recognize(loaded.rgbd);
+    PrintDetections(loaded, result);
+    if (!args.out_json.empty()) WriteJsonFile(args.out_json, RecognitionToJson(result));
+    if (!args.out_bop.empty()) {
+      const auto [scene_id, image_id] = BopIds(args.frame.positional, args.scene_id, args.image_id);
+      std::ostringstream csv;
+      csv << "scene_id,im_id,obj_id,score,R,t,time\n";
+      AppendBopRows(csv, scene_id, image_id, result);
+      WriteTextAtomically(args.out_bop, csv.str());
+    }
+    if (!args.overlay.empty()) WriteColorImage(args.overlay, recognizer.DrawDetections(loaded.rgbd, result.detections));
+    return kExitOk;
+  }
+
+  // A sequence, processed in order as a camera stream would arrive; a broken frame is reported and skipped.
+  std::ostringstream lines, csv;
+  csv << "scene_id,im_id,obj_id,score,R,t,time\n";
+  int failed = 0;
+  double total_ms = 0.0;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    FrameSpec spec;
+    spec.positional = frames[i];
+    try {
+      const LoadedFrame loaded = LoadFrame(spec);
+      const std::pair<int, int> ids = args.out_bop.empty() ? std::pair{-1, -1} : BopIds(frames[i], -1, -1);
+      const RecognitionResult result = recognizer.Recognize(loaded.rgbd);
+      total_ms += result.timings_ms.at("total");
+      std::cout << "[" << i + 1 << "/" << frames.size() << "] ";
+      PrintDetections(loaded, result);
+      nlohmann::json line = RecognitionToJson(result);
+      line["frame"] = frames[i];
+      lines << line.dump() << '\n';
+      if (!args.out_bop.empty()) AppendBopRows(csv, ids.first, ids.second, result);
+    } catch (const InputError& error) {
+      ++failed;
+      std::cerr << "recognize: frame " << frames[i] << " skipped: " << error.what() << '\n';
+      lines << nlohmann::json{{"frame", frames[i]}, {"error", error.what()}}.dump() << '\n';
+    }
+  }
+  const size_t done = frames.size() - static_cast<size_t>(failed);
+  std::cout << std::setprecision(2) << done << " frames in " << total_ms / 1000.0 << " s ("
+            << (total_ms > 0.0 ? 1000.0 * static_cast<double>(done) / total_ms : 0.0) << " frames per second)";
+  if (failed > 0) std::cout << ", " << failed << " failed";
+  std::cout << '\n';
+  if (!args.out_json.empty()) WriteTextAtomically(args.out_json, lines.str());
+  if (!args.out_bop.empty()) WriteTextAtomically(args.out_bop, csv.str());
+  return failed > 0 ? kExitBadInput : kExitOk;
+}
+
+}  // namespace
+
+CommandAction SetupRecognizeCommand(CLI::App& command) {
+  auto args = std::make_shared<RecognizeArgs>();
+  command.add_option("--db", args->db, "Model library (SQLite), from `ecvpose modeldb build`")->required();
+  command.add_option("--models", args->models, "Only these models of the library (default: all)");
+  command.add_option("FRAME", args->frame.positional,
+                     "Frame JSON, YCB-Video prefix, BOP SCENE_DIR:IMAGE_ID or organized .pcd (or the frame flags)");
+  AddFrameFlags(command, &args->frame);
+  command.add_option(
+      "--sequence", args->sequence,
+      "Frames in order: a directory (YCB-Video frames or frame JSONs) or a file with one FRAME per line");
+  command.add_option("--out-json", args->out_json,
+                     "Detections as JSON (DESIGN.md: model, score, camera_from_object); JSON Lines for a sequence");
+  command.add_option("--out-bop", args->out_bop,
+                     "Detections as BOP CSV (scene_id,im_id,obj_id,score,R,t,time; t in mm)");
+  command.add_option("--scene-id", args->scene_id, "BOP scene id (default: from the frame name)");
+  command.add_option("--image-id", args->image_id, "BOP image id (default: from the frame name)");
+  command.add_option("--overlay", args->overlay, "Picture: each detected model in red with its name (PNG)");
+  RecognizerOptions& options = args->options;
+  command.add_option("--views-per-model", options.views_per_model, "Library views tried with RANSAC per model")
+      ->capture_default_str();
+  command.add_option("--min-score", options.min_score, "Detections below this score are dropped")
+      ->capture_default_str();
+  command.add_option("--seed", options.ransac.seed, "Random seed")->capture_default_str();
+  command.add_option("--threads", options.ransac.threads, "RANSAC threads (same result for any count)")
+      ->capture_default_str();
+  command.add_flag(
+      "--no-icp", [&options = args->options](int64_t) { options.refine = false; }, "Skip the ICP refinement");
+  command.footer(
+      "Example:\n  ecvpose modeldb build models/meshes --db lib.sqlite\n"
+      "  ecvpose recognize --db lib.sqlite models/frame/000001 --out-json detections.json --overlay detections.png");
+  return [args] { return RunRecognize(*args); };
+}
+
+}  // namespace ecv::app

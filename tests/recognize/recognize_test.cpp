@@ -1,0 +1,100 @@
+// End to end: a library of the three textured YCB meshes in models/ built with `ecvpose modeldb build`, then
+// `ecvpose recognize` and `ecvpose eval` on the real YCB-Video frame in models/frame.
+
+#include <gtest/gtest.h>
+
+#include "io/frame_io.h"
+#include "io/pose_io.h"
+#include "modeldb/model_library.h"
+#include "recognize/evaluation.h"
+#include "support/test_data.h"
+
+namespace ecv {
+namespace {
+
+class RecognizeEndToEnd : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    directory_ = new test::TemporaryDirectory();
+    library_ = directory_->File("library.sqlite");
+    const test::CommandResult build = test::RunCli("modeldb build " + std::string(ECV_SOURCE_DIR) +
+                                                   "/models/meshes --views 40 --distance 0.9 --db " + library_);
+    ASSERT_EQ(build.exit_code, 0) << build.output;
+  }
+  static void TearDownTestSuite() { delete directory_; }
+
+  static std::string Frame() { return std::string(ECV_SOURCE_DIR) + "/models/frame/000001"; }
+
+  static test::TemporaryDirectory* directory_;
+  static std::string library_;
+};
+
+test::TemporaryDirectory* RecognizeEndToEnd::directory_ = nullptr;
+std::string RecognizeEndToEnd::library_;
+
+TEST_F(RecognizeEndToEnd, FindsTheObjectsOfTheDemoFrameWithinTenthOfTheirDiameter) {
+  const std::string json = directory_->File("detections.json");
+  const test::CommandResult run = test::RunCli("recognize --db " + library_ + " " + Frame() + " --out-json " + json +
+                                               " --overlay " + directory_->File("detections.png"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+
+  const LoadedFrame frame = LoadYcbvFrame(Frame());
+  LibraryLoadOptions load;
+  load.build_matchers = false;
+  const ModelLibrary library = ModelLibrary::Load(library_, load);
+  std::vector<EvalModel> models;
+  for (const LibraryModel& model : library.models()) models.push_back(EvalModelFromRecord(model.record));
+  std::vector<Detection> detections;
+  const nlohmann::json written = ReadJsonFile(json);
+  for (const nlohmann::json& item : written.at("detections")) {
+    Detection detection;
+    detection.model = item.at("model").get<std::string>();
+    detection.camera_from_object = PoseFromJson(item.at("camera_from_object"), json, "camera_from_object");
+    detection.score = item.at("score").get<double>();
+    EXPECT_GT(detection.score, 0.0);
+    EXPECT_LE(detection.score, 1.0);
+    detections.push_back(detection);
+  }
+  const FrameEvaluation evaluation = EvaluateFrame("0001/000001", detections, frame.ground_truth, models);
+  EXPECT_EQ(evaluation.false_positives, 0) << run.output;
+  int correct = 0;
+  for (const ObjectEvaluation& object : evaluation.objects) {
+    if (object.model == "003_cracker_box" || object.model == "006_mustard_bottle") {
+      EXPECT_TRUE(object.correct) << object.model << ": ADD " << object.error.add_m << " m\n" << run.output;
+    }
+    correct += object.correct ? 1 : 0;
+  }
+  EXPECT_GE(correct, 2);
+  EXPECT_EQ(ReadColorImage(directory_->File("detections.png")).size(), frame.rgbd.color.size());
+
+  // The eval command agrees and prints the table.
+  const test::CommandResult eval = test::RunCli("eval --detections " + json + " --db " + library_ + " " + Frame());
+  ASSERT_EQ(eval.exit_code, 0) << eval.output;
+  EXPECT_NE(eval.output.find("| 003_cracker_box | yes |"), std::string::npos) << eval.output;
+}
+
+TEST_F(RecognizeEndToEnd, SameSeedSameDetections) {
+  std::string outputs[2];
+  for (int i = 0; i < 2; ++i) {
+    const std::string json = directory_->File("same" + std::to_string(i) + ".json");
+    const test::CommandResult run = test::RunCli("recognize --db " + library_ + " " + Frame() + " --out-json " + json +
+                                                 " --threads " + std::to_string(i + 1));
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    outputs[i] = ReadJsonFile(json).at("detections").dump();
+  }
+  EXPECT_EQ(outputs[0], outputs[1]) << "one and two threads, the same seed";
+}
+
+TEST_F(RecognizeEndToEnd, BadInputIsReported) {
+  const test::CommandResult missing_db = test::RunCli("recognize --db /nonexistent/lib.sqlite " + Frame());
+  EXPECT_EQ(missing_db.exit_code, 1) << missing_db.output;
+  EXPECT_NE(missing_db.output.find("/nonexistent/lib.sqlite"), std::string::npos) << missing_db.output;
+  const test::CommandResult missing_frame = test::RunCli("recognize --db " + library_ + " /nonexistent/000001");
+  EXPECT_EQ(missing_frame.exit_code, 1) << missing_frame.output;
+  EXPECT_NE(missing_frame.output.find("/nonexistent/000001"), std::string::npos) << missing_frame.output;
+  const test::CommandResult no_db = test::RunCli("recognize " + Frame());
+  EXPECT_EQ(no_db.exit_code, 2) << no_db.output;
+}
+
+}  // namespace
+}  // namespace ecv
