@@ -8,6 +8,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "colorcal/color_matrix.h"
 #include "core/error.h"
 #include "ecv/descriptor.h"
 #include "ecv/primitives.h"
@@ -107,7 +108,16 @@ class Recognizer::Impl {
     options_.Check();
     options_.match.k = 2;
     for (const LibraryModel& model : library_.models()) {
-      const ModelRecord& record = model.record;
+      // With a colour matrix, the views' colours are mapped into the scene camera's colours and their
+      // descriptors recomputed (paper Sect. IV-C: A c_model = c_scene before matching).
+      records_.push_back(model.record);
+      ModelRecord& record = records_.back();
+      if (options_.use_color_matrix && model.color_matrix) {
+        for (ModelView& view : record.views) {
+          ApplyColorMatrix(model.color_matrix->model_to_scene, &view.primitives);
+          view.descriptors = ComputeDescriptors(view.primitives, library_.feature_settings().descriptor);
+        }
+      }
       MeshLoadOptions load;
       load.metres_per_unit = MetresPerUnit(record.unit);
       load.object_from_mesh = record.object_from_mesh;
@@ -128,7 +138,7 @@ class Recognizer::Impl {
       result.timings_ms["match"] += MillisecondsSince(stage);
 
       stage = Clock::now();
-      std::vector<Hypothesis> hypotheses = EstimatePoses(library_.models()[m], views, scene);
+      std::vector<Hypothesis> hypotheses = EstimatePoses(records_[m], views, scene);
       result.timings_ms["ransac"] += MillisecondsSince(stage);
 
       // Every hypothesis is verified as it is; the best one is refined and verified again.
@@ -201,7 +211,7 @@ class Recognizer::Impl {
     std::vector<ViewCandidate> views;
     const ModelIndex& index = indices_[model];
     if (!scene.matcher || !index.matcher) return views;
-    const ModelRecord& record = library_.models()[model].record;
+    const ModelRecord& record = records_[model];
     std::vector<int> votes(record.views.size(), 0);
     const std::vector<DescriptorMatch> matches = index.matcher->Match(scene.primitives, scene.descriptors);
     for (size_t i = 0; i + 1 < matches.size(); ++i) {
@@ -231,11 +241,11 @@ class Recognizer::Impl {
     return views;
   }
 
-  std::vector<Hypothesis> EstimatePoses(const LibraryModel& model, const std::vector<ViewCandidate>& views,
+  std::vector<Hypothesis> EstimatePoses(const ModelRecord& model, const std::vector<ViewCandidate>& views,
                                         const Scene& scene) const {
     std::vector<Hypothesis> hypotheses;
     for (const ViewCandidate& candidate : views) {
-      const ModelView& view = model.record.views[static_cast<size_t>(candidate.view)];
+      const ModelView& view = model.views[static_cast<size_t>(candidate.view)];
       std::vector<Eigen::Vector3f> object_points;
       object_points.reserve(view.primitives.size());
       for (const Primitive& primitive : view.primitives) object_points.push_back(primitive.position);
@@ -366,6 +376,7 @@ class Recognizer::Impl {
  private:
   const ModelLibrary& library_;
   RecognizerOptions options_;
+  std::vector<ModelRecord> records_;  // per model: the library's, colours mapped by its colour matrix if any
   Renderer renderer_;
   std::vector<MeshId> meshes_;
   std::vector<ModelIndex> indices_;  // per model

@@ -36,7 +36,9 @@ struct RecognizerOptions {
   double color_tolerance = 0.2;
   double min_score = 0.25;            ///< detections below are dropped
   double min_visible_fraction = 0.1;  ///< of the model's rendered pixels that the scene can show
-  bool use_color_matrix = true;       ///< apply a model's stored colour matrix (when it has one)
+  /// Apply a model's stored colour matrix (when it has one) to its view colours before matching (the views'
+  /// descriptors are recomputed once, when the Recognizer is made) and to its rendered colours in verification.
+  bool use_color_matrix = true;
 
   static RansacOptions DefaultRansac();
   /// Throws InputError on values outside their ranges.
