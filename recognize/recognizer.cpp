@@ -37,25 +37,29 @@ struct Scene {
   SceneVisibility visibility;
 };
 
-// All views of one model in one index: the scene's descriptors vote with it for the views they match.
-struct ModelIndex {
-  std::vector<Primitive> primitives;  // every view's primitives, view after view
-  std::vector<int> view_of;           // the view of each
+// All views of all models in one index: each scene descriptor votes, through its nearest library
+// descriptor, for one view of one model.
+struct LibraryIndex {
+  std::vector<Primitive> primitives;   // every view's primitives, view after view, model after model
+  std::vector<int> model_of, view_of;  // the model and view of each
   std::unique_ptr<DescriptorMatcher> matcher;
 };
 
-ModelIndex BuildModelIndex(const ModelRecord& record, const MatchOptions& options) {
-  ModelIndex index;
+LibraryIndex BuildLibraryIndex(const std::vector<ModelRecord>& records, const MatchOptions& options) {
+  LibraryIndex index;
   Descriptors all;
   std::vector<cv::Mat> rows;
-  for (size_t v = 0; v < record.views.size(); ++v) {
-    const ModelView& view = record.views[v];
-    const int offset = static_cast<int>(index.primitives.size());
-    index.primitives.insert(index.primitives.end(), view.primitives.begin(), view.primitives.end());
-    index.view_of.insert(index.view_of.end(), view.primitives.size(), static_cast<int>(v));
-    if (view.descriptors.values.rows == 0) continue;
-    rows.push_back(view.descriptors.values);
-    for (const int primitive : view.descriptors.primitive) all.primitive.push_back(primitive + offset);
+  for (size_t m = 0; m < records.size(); ++m) {
+    for (size_t v = 0; v < records[m].views.size(); ++v) {
+      const ModelView& view = records[m].views[v];
+      const int offset = static_cast<int>(index.primitives.size());
+      index.primitives.insert(index.primitives.end(), view.primitives.begin(), view.primitives.end());
+      index.model_of.insert(index.model_of.end(), view.primitives.size(), static_cast<int>(m));
+      index.view_of.insert(index.view_of.end(), view.primitives.size(), static_cast<int>(v));
+      if (view.descriptors.values.rows == 0) continue;
+      rows.push_back(view.descriptors.values);
+      for (const int primitive : view.descriptors.primitive) all.primitive.push_back(primitive + offset);
+    }
   }
   if (rows.empty()) return index;
   cv::vconcat(rows, all.values);
@@ -123,8 +127,8 @@ class Recognizer::Impl {
       load.object_from_mesh = record.object_from_mesh;
       load.allow_missing_textures = true;
       meshes_.push_back(renderer_.AddMesh(LoadMesh(record.mesh_path, load)));
-      indices_.push_back(BuildModelIndex(record, options_.match));
     }
+    index_ = BuildLibraryIndex(records_, options_.match);
   }
 
   RecognitionResult Recognize(const RgbdFrame& frame) {
@@ -132,9 +136,12 @@ class Recognizer::Impl {
     const Clock::time_point start = Clock::now();
     RecognitionResult result;
     const Scene scene = PrepareScene(frame, &result);
+    Clock::time_point stage = Clock::now();
+    const std::vector<std::vector<int>> votes = CountVotes(scene);
+    result.timings_ms["match"] += MillisecondsSince(stage);
     for (size_t m = 0; m < library_.models().size(); ++m) {
-      Clock::time_point stage = Clock::now();
-      const std::vector<ViewCandidate> views = RankViews(m, scene);
+      stage = Clock::now();
+      const std::vector<ViewCandidate> views = RankViews(m, votes[m], scene);
       result.timings_ms["match"] += MillisecondsSince(stage);
 
       stage = Clock::now();
@@ -204,24 +211,31 @@ class Recognizer::Impl {
     return scene;
   }
 
-  // The views with the most votes (scene descriptors whose nearest model descriptor lies in the view and
-  // passes the ratio test), each with its correspondences: the nearest scene descriptor of each of its
-  // descriptors (paper: object to scene).
-  std::vector<ViewCandidate> RankViews(size_t model, const Scene& scene) const {
-    std::vector<ViewCandidate> views;
-    const ModelIndex& index = indices_[model];
-    if (!scene.matcher || !index.matcher) return views;
-    const ModelRecord& record = records_[model];
-    std::vector<int> votes(record.views.size(), 0);
-    const std::vector<DescriptorMatch> matches = index.matcher->Match(scene.primitives, scene.descriptors);
+  // Votes per model and view: scene descriptors whose nearest library descriptor lies in the view and
+  // passes the ratio test against the second nearest.
+  std::vector<std::vector<int>> CountVotes(const Scene& scene) const {
+    std::vector<std::vector<int>> votes;
+    for (const ModelRecord& record : records_) votes.emplace_back(record.views.size(), 0);
+    if (!scene.matcher || !index_.matcher) return votes;
+    const std::vector<DescriptorMatch> matches = index_.matcher->Match(scene.primitives, scene.descriptors);
     for (size_t i = 0; i + 1 < matches.size(); ++i) {
       const DescriptorMatch& nearest = matches[i];
       const DescriptorMatch& second = matches[i + 1];
       if (nearest.rank != 0 || second.rank != 1 || second.query != nearest.query) continue;
       if (nearest.distance < options_.ratio_test * second.distance) {
-        ++votes[static_cast<size_t>(index.view_of[static_cast<size_t>(nearest.train)])];
+        const size_t train = static_cast<size_t>(nearest.train);
+        ++votes[static_cast<size_t>(index_.model_of[train])][static_cast<size_t>(index_.view_of[train])];
       }
     }
+    return votes;
+  }
+
+  // The model's views with the most votes, each with its correspondences: the nearest scene descriptor of
+  // each of its descriptors (paper: object to scene).
+  std::vector<ViewCandidate> RankViews(size_t model, const std::vector<int>& votes, const Scene& scene) const {
+    std::vector<ViewCandidate> views;
+    if (!scene.matcher) return views;
+    const ModelRecord& record = records_[model];
     std::vector<int> order(record.views.size());
     std::iota(order.begin(), order.end(), 0);
     std::stable_sort(order.begin(), order.end(),
@@ -379,7 +393,7 @@ class Recognizer::Impl {
   std::vector<ModelRecord> records_;  // per model: the library's, colours mapped by its colour matrix if any
   Renderer renderer_;
   std::vector<MeshId> meshes_;
-  std::vector<ModelIndex> indices_;  // per model
+  LibraryIndex index_;  // all views of all models
 };
 
 Recognizer::Recognizer(const ModelLibrary& library, const RecognizerOptions& options)
