@@ -13,17 +13,12 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/timing.h"
 #include "io/mesh_io.h"
 #include "modeldb/content_hash.h"
 
 namespace ecv {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double MillisecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 // Removes an uploaded mesh from the renderer however the build ends.
 class UploadedMesh {

@@ -6,13 +6,10 @@
 #include <thread>
 
 #include "core/error.h"
+#include "core/timing.h"
 
 namespace ecv {
 namespace {
-
-double MillisecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-}
 
 // Builds every view's matcher; views are shared out to `threads` workers.
 void BuildMatchers(std::vector<LibraryModel>* models, const LibraryLoadOptions& options) {

@@ -10,6 +10,7 @@
 
 #include "colorcal/color_matrix.h"
 #include "core/error.h"
+#include "core/timing.h"
 #include "ecv/descriptor.h"
 #include "ecv/primitives.h"
 #include "io/mesh_io.h"
@@ -20,12 +21,6 @@
 
 namespace ecv {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double MillisecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 // What one frame offers to every model: primitives with descriptors, a matcher over them, dense points.
 struct Scene {

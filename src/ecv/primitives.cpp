@@ -8,17 +8,12 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
+#include "core/timing.h"
 #include "ecv/hex_grid.h"
 #include "ecv/surface.h"
 
 namespace ecv {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double MillisecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 // Per-cell statistics of the monogenic signal.
 struct CellStats {

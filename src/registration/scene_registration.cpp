@@ -4,13 +4,10 @@
 #include <chrono>
 
 #include "core/error.h"
+#include "core/timing.h"
 
 namespace ecv {
 namespace {
-
-double MillisecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-}
 
 std::vector<Eigen::Vector3f> Positions(const std::vector<Primitive>& primitives) {
   std::vector<Eigen::Vector3f> positions;

@@ -2,11 +2,8 @@
 // others bit for bit; list, info, remove, replace, verify, export; a bad mesh in a directory; a read-only
 // location; files that are not libraries, or of another schema version.
 
-#include <sys/wait.h>
 #include <unistd.h>
 
-#include <array>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
@@ -57,17 +54,7 @@ void LinkModels(const fs::path& directory, const std::vector<std::string>& names
 
 // Runs ecvpose with `arguments`, as an unprivileged user when we are root (so that file permissions hold).
 test::CommandResult RunCliUnprivileged(const std::string& arguments) {
-  const std::string prefix = geteuid() == 0 ? "setpriv --reuid=65534 --regid=65534 --clear-groups " : "";
-  const std::string command = prefix + ECV_CLI_PATH + " " + arguments + " 2>&1";
-  test::CommandResult result;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return result;
-  std::array<char, 4096> buffer{};
-  size_t count = 0;
-  while ((count = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) result.output.append(buffer.data(), count);
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
+  return test::RunCli(arguments, geteuid() == 0 ? "setpriv --reuid=65534 --regid=65534 --clear-groups " : "");
 }
 
 // One library built by the CLI, shared by the tests (each works on its own copy when it changes it).

@@ -31,8 +31,8 @@ TemporaryDirectory::~TemporaryDirectory() {
   std::filesystem::remove_all(path_, ignored);
 }
 
-CommandResult RunCli(const std::string& arguments) {
-  const std::string command = std::string(ECV_CLI_PATH) + " " + arguments + " 2>&1";
+CommandResult RunCli(const std::string& arguments, const std::string& prefix) {
+  const std::string command = prefix + ECV_CLI_PATH + " " + arguments + " 2>&1";
   CommandResult result;
   FILE* pipe = popen(command.c_str(), "r");
   if (pipe == nullptr) return result;

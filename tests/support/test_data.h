@@ -30,7 +30,8 @@ struct CommandResult {
   std::string output;  ///< standard output and standard error together
 };
 
-/// Runs the ecvpose tool with `arguments` (shell syntax).
-CommandResult RunCli(const std::string& arguments);
+/// Runs the ecvpose tool with `arguments` (shell syntax), after `prefix` (e.g. a command that drops
+/// privileges) when given.
+CommandResult RunCli(const std::string& arguments, const std::string& prefix = "");
 
 }  // namespace ecv::test
