@@ -32,19 +32,21 @@ struct Scene {
   SceneVisibility visibility;
 };
 
-// All views of all models in one index: each scene descriptor votes, through its nearest library
-// descriptor, for one view of one model.
+// The views of one model, or of all, in one index: each scene descriptor votes, through its nearest
+// descriptor there, for one view of one model.
 struct LibraryIndex {
   std::vector<Primitive> primitives;   // every view's primitives, view after view, model after model
   std::vector<int> model_of, view_of;  // the model and view of each
   std::unique_ptr<DescriptorMatcher> matcher;
 };
 
-LibraryIndex BuildLibraryIndex(const std::vector<ModelRecord>& records, const MatchOptions& options) {
+// An index over the views of records[first .. last).
+LibraryIndex BuildVoteIndex(const std::vector<ModelRecord>& records, size_t first, size_t last,
+                            const MatchOptions& options) {
   LibraryIndex index;
   Descriptors all;
   std::vector<cv::Mat> rows;
-  for (size_t m = 0; m < records.size(); ++m) {
+  for (size_t m = first; m < last; ++m) {
     for (size_t v = 0; v < records[m].views.size(); ++v) {
       const ModelView& view = records[m].views[v];
       const int offset = static_cast<int>(index.primitives.size());
@@ -123,7 +125,12 @@ class Recognizer::Impl {
       load.allow_missing_textures = true;
       meshes_.push_back(renderer_.AddMesh(LoadMesh(record.mesh_path, load)));
     }
-    index_ = BuildLibraryIndex(records_, options_.match);
+    if (options_.library_wide_votes) {
+      vote_indices_.push_back(BuildVoteIndex(records_, 0, records_.size(), options_.match));
+    } else {
+      for (size_t m = 0; m < records_.size(); ++m)
+        vote_indices_.push_back(BuildVoteIndex(records_, m, m + 1, options_.match));
+    }
   }
 
   RecognitionResult Recognize(const RgbdFrame& frame) {
@@ -211,15 +218,18 @@ class Recognizer::Impl {
   std::vector<std::vector<int>> CountVotes(const Scene& scene) const {
     std::vector<std::vector<int>> votes;
     for (const ModelRecord& record : records_) votes.emplace_back(record.views.size(), 0);
-    if (!scene.matcher || !index_.matcher) return votes;
-    const std::vector<DescriptorMatch> matches = index_.matcher->Match(scene.primitives, scene.descriptors);
-    for (size_t i = 0; i + 1 < matches.size(); ++i) {
-      const DescriptorMatch& nearest = matches[i];
-      const DescriptorMatch& second = matches[i + 1];
-      if (nearest.rank != 0 || second.rank != 1 || second.query != nearest.query) continue;
-      if (nearest.distance < options_.ratio_test * second.distance) {
-        const size_t train = static_cast<size_t>(nearest.train);
-        ++votes[static_cast<size_t>(index_.model_of[train])][static_cast<size_t>(index_.view_of[train])];
+    if (!scene.matcher) return votes;
+    for (const LibraryIndex& index : vote_indices_) {
+      if (!index.matcher) continue;
+      const std::vector<DescriptorMatch> matches = index.matcher->Match(scene.primitives, scene.descriptors);
+      for (size_t i = 0; i + 1 < matches.size(); ++i) {
+        const DescriptorMatch& nearest = matches[i];
+        const DescriptorMatch& second = matches[i + 1];
+        if (nearest.rank != 0 || second.rank != 1 || second.query != nearest.query) continue;
+        if (nearest.distance < options_.ratio_test * second.distance) {
+          const size_t train = static_cast<size_t>(nearest.train);
+          ++votes[static_cast<size_t>(index.model_of[train])][static_cast<size_t>(index.view_of[train])];
+        }
       }
     }
     return votes;
@@ -388,7 +398,7 @@ class Recognizer::Impl {
   std::vector<ModelRecord> records_;  // per model: the library's, colours mapped by its colour matrix if any
   Renderer renderer_;
   std::vector<MeshId> meshes_;
-  LibraryIndex index_;  // all views of all models
+  std::vector<LibraryIndex> vote_indices_;  // one per model, or one for all (library_wide_votes)
 };
 
 Recognizer::Recognizer(const ModelLibrary& library, const RecognizerOptions& options)
