@@ -22,28 +22,8 @@ struct EvalArgs {
   std::string out_markdown;
 };
 
-std::vector<Detection> ReadDetections(const std::string& path) {
-  const nlohmann::json json = ReadJsonFile(path);
-  if (!json.contains("detections") || !json["detections"].is_array()) {
-    ThrowInputError(path, "detections", "an array of detections (ecvpose recognize --out-json)");
-  }
-  std::vector<Detection> detections;
-  for (size_t i = 0; i < json["detections"].size(); ++i) {
-    const nlohmann::json& item = json["detections"][i];
-    const std::string field = "detections[" + std::to_string(i) + "]";
-    if (!item.contains("model") || !item["model"].is_string()) ThrowInputError(path, field + ".model", "a string");
-    Detection detection;
-    detection.model = item["model"].get<std::string>();
-    detection.camera_from_object =
-        PoseFromJson(item.value("camera_from_object", nlohmann::json()), path, field + ".camera_from_object");
-    detection.score = item.value("score", 0.0);
-    detections.push_back(detection);
-  }
-  return detections;
-}
-
 int RunEval(const EvalArgs& args) {
-  const std::vector<Detection> detections = ReadDetections(args.detections);
+  const std::vector<Detection> detections = DetectionsFromJson(ReadJsonFile(args.detections), args.detections);
   const LoadedFrame frame = LoadFrame(args.frame);
   if (frame.ground_truth.empty()) {
     ThrowInputError(frame.rgbd.name, "ground truth", "a frame with ground-truth poses (YCB-Video prefix or BOP image)");

@@ -200,7 +200,7 @@ class Recognizer::Impl {
     }
     result->timings_ms["describe"] = MillisecondsSince(stage);
 
-    for (const Primitive& primitive : scene.primitives) scene.points.push_back(primitive.position);
+    scene.points = PrimitivePositions(scene.primitives);
     const int stride = options_.dense_stride_px;
     for (int v = 0; v < frame.depth.rows; v += stride) {
       for (int u = 0; u < frame.depth.cols; u += stride) {
@@ -265,9 +265,7 @@ class Recognizer::Impl {
     std::vector<Hypothesis> hypotheses;
     for (const ViewCandidate& candidate : views) {
       const ModelView& view = model.views[static_cast<size_t>(candidate.view)];
-      std::vector<Eigen::Vector3f> object_points;
-      object_points.reserve(view.primitives.size());
-      for (const Primitive& primitive : view.primitives) object_points.push_back(primitive.position);
+      const std::vector<Eigen::Vector3f> object_points = PrimitivePositions(view.primitives);
       Hypothesis hypothesis;
       hypothesis.view = candidate.view;
       hypothesis.ransac = EstimatePoseRansac(object_points, scene.points, candidate.correspondences, options_.ransac,
@@ -428,6 +426,25 @@ nlohmann::json RecognitionToJson(const RecognitionResult& result) {
                           {"visible_fraction", d.visible_fraction}});
   }
   return {{"detections", detections}, {"timings_ms", result.timings_ms}, {"scene_primitives", result.scene_primitives}};
+}
+
+std::vector<Detection> DetectionsFromJson(const nlohmann::json& json, const std::string& source) {
+  if (!json.contains("detections") || !json["detections"].is_array()) {
+    ThrowInputError(source, "detections", "an array of detections (ecvpose recognize --out-json)");
+  }
+  std::vector<Detection> detections;
+  for (size_t i = 0; i < json["detections"].size(); ++i) {
+    const nlohmann::json& item = json["detections"][i];
+    const std::string field = "detections[" + std::to_string(i) + "]";
+    if (!item.contains("model") || !item["model"].is_string()) ThrowInputError(source, field + ".model", "a string");
+    Detection detection;
+    detection.model = item["model"].get<std::string>();
+    detection.camera_from_object =
+        PoseFromJson(item.value("camera_from_object", nlohmann::json()), source, field + ".camera_from_object");
+    detection.score = item.value("score", 0.0);
+    detections.push_back(detection);
+  }
+  return detections;
 }
 
 }  // namespace ecv

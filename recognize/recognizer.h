@@ -73,6 +73,10 @@ struct RecognitionResult {
 /// "inlier_fraction", "fit_error", "view", ...}], "timings_ms": {stage: ms}}.
 nlohmann::json RecognitionToJson(const RecognitionResult& result);
 
+/// The detections of such JSON (model, score, camera_from_object); throws InputError naming `source` and the
+/// field when one is missing or malformed.
+std::vector<Detection> DetectionsFromJson(const nlohmann::json& json, const std::string& source);
+
 /// Finds the library's models in RGB-D frames. Owns an offscreen renderer (for verification) with the
 /// models' meshes, loaded from the paths stored in the library. One Recognizer per thread.
 class Recognizer {

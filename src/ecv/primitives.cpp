@@ -192,4 +192,11 @@ ExtractionResult ExtractPrimitives(const RgbdFrame& frame, const EcvOptions& opt
   return result;
 }
 
+std::vector<Eigen::Vector3f> PrimitivePositions(const std::vector<Primitive>& primitives) {
+  std::vector<Eigen::Vector3f> positions;
+  positions.reserve(primitives.size());
+  for (const Primitive& primitive : primitives) positions.push_back(primitive.position);
+  return positions;
+}
+
 }  // namespace ecv

@@ -76,4 +76,7 @@ struct ExtractionResult {
 /// `mask` (CV_8UC1, optional) restricts keypoints to non-zero pixels.
 ExtractionResult ExtractPrimitives(const RgbdFrame& frame, const EcvOptions& options = {}, const cv::Mat& mask = {});
 
+/// The positions of `primitives`, in order (the point sets of RANSAC and ICP).
+std::vector<Eigen::Vector3f> PrimitivePositions(const std::vector<Primitive>& primitives);
+
 }  // namespace ecv

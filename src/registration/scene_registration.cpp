@@ -7,17 +7,6 @@
 #include "core/timing.h"
 
 namespace ecv {
-namespace {
-
-std::vector<Eigen::Vector3f> Positions(const std::vector<Primitive>& primitives) {
-  std::vector<Eigen::Vector3f> positions;
-  positions.reserve(primitives.size());
-  for (const Primitive& primitive : primitives) positions.push_back(primitive.position);
-  return positions;
-}
-
-}  // namespace
-
 RansacOptions RegistrationOptions::SceneRansacOptions() {
   RansacOptions options;
   options.required_inlier_fraction = 0.1;
@@ -81,7 +70,8 @@ RegistrationResult RegisterViews(const RegistrationView& a, const RegistrationVi
   result.match_ms = MillisecondsSince(start);
 
   start = std::chrono::steady_clock::now();
-  result.ransac = EstimatePoseRansac(Positions(a.primitives), Positions(b.primitives), correspondences, options.ransac);
+  result.ransac = EstimatePoseRansac(PrimitivePositions(a.primitives), PrimitivePositions(b.primitives),
+                                     correspondences, options.ransac);
   result.ransac_ms = MillisecondsSince(start);
   result.success = result.ransac.success;
   result.b_from_a = result.ransac.scene_from_object;

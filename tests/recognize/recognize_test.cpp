@@ -44,16 +44,10 @@ TEST_F(RecognizeEndToEnd, FindsTheObjectsOfTheDemoFrameWithinTenthOfTheirDiamete
   const ModelLibrary library = ModelLibrary::Load(library_, load);
   std::vector<EvalModel> models;
   for (const LibraryModel& model : library.models()) models.push_back(EvalModelFromRecord(model.record));
-  std::vector<Detection> detections;
-  const nlohmann::json written = ReadJsonFile(json);
-  for (const nlohmann::json& item : written.at("detections")) {
-    Detection detection;
-    detection.model = item.at("model").get<std::string>();
-    detection.camera_from_object = PoseFromJson(item.at("camera_from_object"), json, "camera_from_object");
-    detection.score = item.at("score").get<double>();
+  const std::vector<Detection> detections = DetectionsFromJson(ReadJsonFile(json), json);
+  for (const Detection& detection : detections) {
     EXPECT_GT(detection.score, 0.0);
     EXPECT_LE(detection.score, 1.0);
-    detections.push_back(detection);
   }
   const FrameEvaluation evaluation = EvaluateFrame("0001/000001", detections, frame.ground_truth, models);
   EXPECT_EQ(evaluation.false_positives, 0) << run.output;
