@@ -1,5 +1,8 @@
-// `ecvpose eval --detections F --db lib.sqlite FRAME`: detections against a frame's ground truth.
+// `ecvpose eval --db lib.sqlite --detections F (FRAME | --gt-bop SCENE_DIR | --gt-ycbv VIDEO_DIR)`: detections
+// against ground truth, for one frame or for every frame of a BOP scene or YCB-Video video folder.
 
+#include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -19,28 +22,65 @@ struct EvalArgs {
   std::string detections;
   std::string db;
   FrameSpec frame;
+  std::string gt_bop;
+  std::string gt_ycbv;
   std::string out_markdown;
+  std::string out_json;
 };
 
-int RunEval(const EvalArgs& args) {
+// One detections JSON against the ground truth of one frame.
+std::vector<FrameEvaluation> EvaluateOneFrame(const EvalArgs& args, const std::vector<EvalModel>& models) {
   const std::vector<Detection> detections = DetectionsFromJson(ReadJsonFile(args.detections), args.detections);
+  for (size_t i = 0; i < detections.size(); ++i) {
+    const bool known = std::any_of(models.begin(), models.end(),
+                                   [&](const EvalModel& model) { return model.name == detections[i].model; });
+    if (!known) {
+      ThrowInputError(args.detections, "detections[" + std::to_string(i) + "].model",
+                      "a model of the library " + args.db, "'" + detections[i].model + "'");
+    }
+  }
   const LoadedFrame frame = LoadFrame(args.frame);
   if (frame.ground_truth.empty()) {
     ThrowInputError(frame.rgbd.name, "ground truth", "a frame with ground-truth poses (YCB-Video prefix or BOP image)");
+  }
+  return {EvaluateFrame(frame.rgbd.name, detections, frame.ground_truth, models)};
+}
+
+void WriteText(const std::string& path, const std::string& text) {
+  const std::string temporary = path + ".tmp";
+  {
+    std::ofstream out(temporary);
+    out << text;
+    if (!out) ThrowInputError(path, "output", "a writable file");
+  }
+  std::filesystem::rename(temporary, path);
+}
+
+int RunEval(const EvalArgs& args) {
+  const int forms =
+      (args.frame.positional.empty() ? 0 : 1) + (args.gt_bop.empty() ? 0 : 1) + (args.gt_ycbv.empty() ? 0 : 1);
+  if (forms != 1) {
+    std::cerr << "ecvpose eval: give exactly one of FRAME, --gt-bop SCENE_DIR or --gt-ycbv VIDEO_DIR\n";
+    return kExitBadUsage;
   }
   LibraryLoadOptions load;
   load.build_matchers = false;
   const ModelLibrary library = ModelLibrary::Load(args.db, load);
   std::vector<EvalModel> models;
   for (const LibraryModel& model : library.models()) models.push_back(EvalModelFromRecord(model.record));
-  const std::string table =
-      EvaluationMarkdown({EvaluateFrame(frame.rgbd.name, detections, frame.ground_truth, models)});
-  std::cout << table;
-  if (!args.out_markdown.empty()) {
-    std::ofstream out(args.out_markdown);
-    out << table;
-    if (!out) ThrowInputError(args.out_markdown, "markdown", "a writable file");
+
+  std::vector<FrameEvaluation> frames;
+  if (!args.frame.positional.empty()) {
+    frames = EvaluateOneFrame(args, models);
+  } else if (!args.gt_ycbv.empty()) {
+    frames = EvaluateDetectionsFile(args.detections, GroundTruthFolder::kYcbVideo, args.gt_ycbv, models);
+  } else {
+    frames = EvaluateDetectionsFile(args.detections, GroundTruthFolder::kBopScene, args.gt_bop, models);
   }
+  const std::string table = EvaluationMarkdown(frames);
+  std::cout << table;
+  if (!args.out_markdown.empty()) WriteText(args.out_markdown, table);
+  if (!args.out_json.empty()) WriteJsonFile(args.out_json, EvaluationToJson(frames));
   return kExitOk;
 }
 
@@ -48,14 +88,21 @@ int RunEval(const EvalArgs& args) {
 
 CommandAction SetupEvalCommand(CLI::App& command) {
   auto args = std::make_shared<EvalArgs>();
-  command.add_option("--detections", args->detections, "Detections JSON (ecvpose recognize --out-json)")->required();
-  command.add_option("--db", args->db, "The model library the detections came from (meshes, diameters)")->required();
-  command.add_option("FRAME", args->frame.positional, "YCB-Video prefix or BOP SCENE_DIR:IMAGE_ID with ground truth")
+  command
+      .add_option("--detections", args->detections,
+                  "Detections: JSON of one frame (recognize --out-json), the JSON Lines of recognize --sequence, "
+                  "or a BOP CSV (recognize --out-bop)")
       ->required();
-  command.add_option("--out-md", args->out_markdown, "The table as a markdown file");
+  command.add_option("--db", args->db, "The model library the detections came from (meshes, diameters)")->required();
+  command.add_option("FRAME", args->frame.positional, "YCB-Video prefix or BOP SCENE_DIR:IMAGE_ID with ground truth");
+  command.add_option("--gt-bop", args->gt_bop, "BOP scene folder: ground truth from its scene_gt.json");
+  command.add_option("--gt-ycbv", args->gt_ycbv, "YCB-Video video folder: ground truth from each frame's -meta.mat");
+  command.add_option("--out-md", args->out_markdown, "The tables as a markdown file");
+  command.add_option("--out-json", args->out_json, "Per frame and object numbers (metres, radians) and totals");
   command.footer(
       "Per object: rotation and translation error, ADD, ADD-S, and correct when ADD (ADD-S for symmetric models)\n"
-      "is below 0.1 x diameter; then recall and false positives.");
+      "is below 0.1 x diameter; then recall and false positives, overall and per model. With --gt-bop/--gt-ycbv,\n"
+      "frames of the folder without a line in the detections (or with an \"error\" line) count as missed.");
   return [args] { return RunEval(*args); };
 }
 

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
 
 #include "core/pose.h"
 #include "modeldb/model_record.h"
@@ -47,15 +48,40 @@ struct ObjectEvaluation {
 struct FrameEvaluation {
   std::string frame;
   std::vector<ObjectEvaluation> objects;  ///< one per ground-truth object that is in `models`
-  int false_positives = 0;                ///< detections of models not in the frame, or wrong (ADD >= 0.1 d)
+  int false_positives = 0;                ///< detections of models not in the frame, wrong (ADD >= 0.1 d) or repeated
+  std::vector<std::string> false_positive_models;  ///< the model of each false positive
+  /// Why the frame had no detections to judge (all its objects count as missed): "no line in the detections"
+  /// or the error `recognize` reported for it; empty when its detections were judged.
+  std::string missed;
 };
 
-/// Matches detections to the ground truth by model name (one instance per model).
+/// Matches detections to the ground truth by model name (one instance per model): the highest-scoring
+/// detection of a model present is judged; further detections of it count as false positives.
 FrameEvaluation EvaluateFrame(const std::string& frame, const std::vector<Detection>& detections,
                               const std::vector<GroundTruth>& truth, const std::vector<EvalModel>& models);
 
-/// Markdown table: per object rotation / translation error, ADD, ADD-S, correct; then recall and false
-/// positives over all frames.
+/// Markdown table: per object rotation / translation error, ADD, ADD-S, correct; the frames counted as missed
+/// and why; then recall and false positives over all frames, and per model.
 std::string EvaluationMarkdown(const std::vector<FrameEvaluation>& frames);
+
+/// Per frame and object numbers (metres, radians) and the totals, per model and overall, as JSON.
+nlohmann::json EvaluationToJson(const std::vector<FrameEvaluation>& frames);
+
+/// Where the ground truth of a folder of frames comes from.
+enum class GroundTruthFolder {
+  kYcbVideo,  ///< a YCB-Video video folder: <frame>-meta.mat beside each <frame>-color.png
+  kBopScene,  ///< a BOP scene folder: scene_gt.json (images are not needed)
+};
+
+/// Evaluates a detections file against every frame of a ground-truth folder, in the folder's order.
+/// `detections_path` holds either the JSON Lines of `ecvpose recognize --sequence` (per line "frame" and
+/// "detections", or "error") or a BOP CSV (header scene_id,im_id,obj_id,score,R,t,time; R row-major, t in
+/// mm; obj_id is "obj_%06d" for BOP, the YCB-Video class index otherwise). The folder's frames are the
+/// YCB-Video frames (*-color.png), or the BOP images of scene_gt.json with an rgb/ (or gray/) image plus those
+/// the detections name. A line or row naming another frame, a model not in `models`, or a malformed line is an
+/// InputError naming the file, the line and the field. Frames without a line, or whose line is an "error",
+/// come back with `missed` set.
+std::vector<FrameEvaluation> EvaluateDetectionsFile(const std::string& detections_path, GroundTruthFolder kind,
+                                                    const std::string& folder, const std::vector<EvalModel>& models);
 
 }  // namespace ecv

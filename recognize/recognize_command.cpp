@@ -1,6 +1,5 @@
 // `ecvpose recognize --db lib.sqlite FRAME`: finds the library's objects in an RGB-D frame.
 
-#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -31,36 +30,6 @@ struct RecognizeArgs {
   int scene_id = -1, image_id = -1;
   std::string overlay;
 };
-
-// The frames of --sequence: a directory of YCB-Video frames (*-color.png) or frame JSONs, in name order, or
-// a text file with one FRAME per line ('#' starts a comment).
-std::vector<std::string> SequenceFrames(const std::string& path) {
-  namespace fs = std::filesystem;
-  std::vector<std::string> frames;
-  if (fs::is_directory(path)) {
-    for (const auto& entry : fs::directory_iterator(path)) {
-      const std::string name = entry.path().string();
-      const std::string suffix = "-color.png";
-      if (name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0) {
-        frames.push_back(name.substr(0, name.size() - suffix.size()));
-      } else if (entry.path().extension() == ".json") {
-        frames.push_back(name);
-      }
-    }
-    std::sort(frames.begin(), frames.end());
-  } else {
-    std::ifstream in(path);
-    if (!in) ThrowInputError(path, "sequence", "a directory of frames or a text file with one FRAME per line");
-    for (std::string line; std::getline(in, line);) {
-      line = line.substr(0, line.find('#'));
-      line.erase(0, line.find_first_not_of(" \t\r"));
-      line.erase(line.find_last_not_of(" \t\r") + 1);
-      if (!line.empty()) frames.push_back(line);
-    }
-  }
-  if (frames.empty()) ThrowInputError(path, "sequence", "at least one frame (*-color.png, *.json, or lines)");
-  return frames;
-}
 
 // BOP object id of a model: the number in "obj_000005", or the YCB-Video class index of "003_cracker_box".
 int BopObjectId(const std::string& model) {
@@ -140,7 +109,7 @@ int RunRecognize(const RecognizeArgs& args) {
     ThrowInputError("recognize", "--overlay", "one frame (not with --sequence)");
   }
   std::vector<std::string> frames;
-  if (!args.sequence.empty()) frames = SequenceFrames(args.sequence);
+  if (!args.sequence.empty()) frames = ListSequenceFrames(args.sequence);
   LibraryLoadOptions load;
   load.names = args.models;
   load.build_matchers = false;  // the scene is indexed, the views are queried
@@ -211,7 +180,8 @@ CommandAction SetupRecognizeCommand(CLI::App& command) {
   AddFrameFlags(command, &args->frame);
   command.add_option(
       "--sequence", args->sequence,
-      "Frames in order: a directory (YCB-Video frames or frame JSONs) or a file with one FRAME per line");
+      "Frames in order: a BOP scene folder, a YCB-Video video folder, a directory of frame JSONs, or a file with\n"
+      "one FRAME per line");
   command.add_option("--out-json", args->out_json,
                      "Detections as JSON (DESIGN.md: model, score, camera_from_object); JSON Lines for a sequence");
   command.add_option("--out-bop", args->out_bop,

@@ -41,7 +41,9 @@ cv::Rect Box(const nlohmann::json& entry, const char* key, const std::string& pa
   return {static_cast<int>(box[0]), static_cast<int>(box[1]), static_cast<int>(box[2]), static_cast<int>(box[3])};
 }
 
-std::vector<GroundTruth> ReadGroundTruth(const std::string& scene_dir, int image_id) {
+}  // namespace
+
+std::vector<GroundTruth> ReadBopGroundTruth(const std::string& scene_dir, int image_id) {
   const std::string gt_path = (fs::path(scene_dir) / "scene_gt.json").string();
   if (!fs::exists(gt_path)) return {};
   const nlohmann::json gt_file = ReadJsonFile(gt_path);
@@ -83,8 +85,6 @@ std::vector<GroundTruth> ReadGroundTruth(const std::string& scene_dir, int image
   return truths;
 }
 
-}  // namespace
-
 LoadedFrame LoadBopFrame(const std::string& scene_dir, int image_id, const std::string& depth_override) {
   const std::string camera_path = (fs::path(scene_dir) / "scene_camera.json").string();
   const nlohmann::json camera_file = ReadJsonFile(camera_path);
@@ -104,7 +104,7 @@ LoadedFrame LoadBopFrame(const std::string& scene_dir, int image_id, const std::
   LoadedFrame loaded;
   loaded.rgbd = MakeFrame(color_path, depth_path, 1000.0 / depth_scale_mm, {k[0], k[4], k[2], k[5]},
                           scene_dir + ":" + std::to_string(image_id));
-  loaded.ground_truth = ReadGroundTruth(scene_dir, image_id);
+  loaded.ground_truth = ReadBopGroundTruth(scene_dir, image_id);
   return loaded;
 }
 

@@ -1,7 +1,10 @@
 #include "io/frame_io.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <sstream>
 
 #include <opencv2/imgcodecs.hpp>
@@ -74,7 +77,100 @@ LoadedFrame LoadPositional(const FrameSpec& spec) {
   ThrowInputError(path, "FRAME", kFrameForms, "no such file, YCB-Video prefix or BOP scene directory");
 }
 
+// Image ids of a BOP scene whose colour (rgb/ PNG or JPG, or gray/) and depth/ PNG exist, in increasing order.
+std::vector<std::string> ListBopSceneFrames(const fs::path& scene_dir) {
+  const std::string camera_path = (scene_dir / "scene_camera.json").string();
+  const nlohmann::json cameras = ReadJsonFile(camera_path);
+  if (!cameras.is_object()) ThrowInputError(camera_path, "image ids", "an object keyed by image id");
+  std::vector<int> ids;
+  for (const auto& item : cameras.items()) {
+    const std::string& key = item.key();
+    if (key.empty() || key.size() > 9 || key.find_first_not_of("0123456789") != std::string::npos) {
+      ThrowInputError(camera_path, key, "image ids as decimal keys");
+    }
+    ids.push_back(std::stoi(key));
+  }
+  std::sort(ids.begin(), ids.end());
+  if (!fs::is_directory(scene_dir / "depth")) {
+    ThrowInputError((scene_dir / "depth").string(), "depth",
+                    "a depth/ folder with the depth PNGs of the images of scene_camera.json",
+                    "no such folder (a single image can be given as SCENE_DIR:ID with --depth)");
+  }
+  std::vector<std::string> frames;
+  for (const int id : ids) {
+    char name[16];
+    std::snprintf(name, sizeof(name), "%06d", id);
+    const std::string stem = name;
+    bool has_color = false;
+    for (const auto& [folder, extension] :
+         {std::pair{"rgb", ".png"}, std::pair{"rgb", ".jpg"}, std::pair{"gray", ".png"}, std::pair{"gray", ".tif"}}) {
+      has_color = has_color || fs::exists(scene_dir / folder / (stem + extension));
+    }
+    if (has_color && fs::exists(scene_dir / "depth" / (stem + ".png"))) {
+      frames.push_back(scene_dir.string() + ":" + std::to_string(id));
+    }
+  }
+  if (frames.empty()) {
+    ThrowInputError(
+        scene_dir.string(), "sequence",
+        "an image of scene_camera.json with both rgb/ and depth/ files (" + std::to_string(ids.size()) + " ids listed)",
+        "none");
+  }
+  return frames;
+}
+
+// YCB-Video prefixes (*-color.png) and frame JSONs of a directory, in name order.
+std::vector<std::string> ListDirectoryFrames(const fs::path& directory) {
+  std::vector<std::string> frames;
+  for (const auto& entry : fs::directory_iterator(directory)) {
+    const std::string name = entry.path().string();
+    const std::string suffix = "-color.png";
+    if (EndsWith(name, suffix)) {
+      frames.push_back(name.substr(0, name.size() - suffix.size()));
+    } else if (entry.path().extension() == ".json") {
+      frames.push_back(name);
+    }
+  }
+  std::sort(frames.begin(), frames.end());
+  return frames;
+}
+
+// One FRAME per line of a text file; '#' starts a comment.
+std::vector<std::string> ListFileFrames(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) ThrowInputError(path, "sequence", "a directory of frames or a text file with one FRAME per line");
+  std::vector<std::string> frames;
+  for (std::string line; std::getline(in, line);) {
+    line = line.substr(0, line.find('#'));
+    line.erase(0, line.find_first_not_of(" \t\r"));
+    line.erase(line.find_last_not_of(" \t\r") + 1);
+    if (!line.empty()) frames.push_back(line);
+  }
+  return frames;
+}
+
 }  // namespace
+
+std::vector<std::string> ListSequenceFrames(const std::string& dir_or_list) {
+  if (!fs::exists(dir_or_list)) {
+    ThrowInputError(dir_or_list, "sequence", "a directory of frames or a text file with one FRAME per line",
+                    "no such file or directory");
+  }
+  if (!fs::is_directory(dir_or_list)) {
+    std::vector<std::string> frames = ListFileFrames(dir_or_list);
+    if (frames.empty()) ThrowInputError(dir_or_list, "sequence", "at least one FRAME line", "none");
+    return frames;
+  }
+  fs::path directory(dir_or_list);
+  if (!directory.has_filename()) directory = directory.parent_path();  // "dir/" -> "dir"
+  if (fs::exists(directory / "scene_camera.json")) return ListBopSceneFrames(directory);
+  std::vector<std::string> frames = ListDirectoryFrames(directory);
+  if (frames.empty()) {
+    ThrowInputError(dir_or_list, "sequence",
+                    "a BOP scene (scene_camera.json), YCB-Video frames (*-color.png) or frame JSONs (*.json)", "none");
+  }
+  return frames;
+}
 
 LoadedFrame LoadFrame(const FrameSpec& spec) {
   if (!spec.positional.empty()) return LoadPositional(spec);

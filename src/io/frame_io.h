@@ -58,6 +58,20 @@ LoadedFrame LoadYcbvFrame(const std::string& prefix);
 /// rgb/, depth/); `depth_override` replaces the depth image when not empty.
 LoadedFrame LoadBopFrame(const std::string& scene_dir, int image_id, const std::string& depth_override = "");
 
+/// Ground truth of BOP image `image_id` from `scene_dir`/scene_gt.json (poses, millimetres -> metres) and
+/// scene_gt_info.json when present, without reading any image. Empty when the scene has no scene_gt.json;
+/// throws InputError naming the file when it lacks the image or is malformed.
+std::vector<GroundTruth> ReadBopGroundTruth(const std::string& scene_dir, int image_id);
+
+/// The frames of a sequence, in order, as FRAME strings that LoadFrame accepts. `dir_or_list` is one of:
+/// - a BOP scene folder (has scene_camera.json): "SCENE_DIR:ID" for every image id of scene_camera.json, in
+///   increasing order, whose rgb/ (PNG or JPG; or gray/) and depth/ PNG files both exist;
+/// - a YCB-Video video folder (prefixes of its *-color.png files) and/or frame JSONs (*.json), in name order;
+/// - a text file with one FRAME per line ('#' starts a comment, blank lines are skipped).
+/// Throws InputError naming the path when it is none of these or yields no frame (e.g. a BOP scene without
+/// a depth/ folder).
+std::vector<std::string> ListSequenceFrames(const std::string& dir_or_list);
+
 /// Organized point cloud with colour (x y z rgb/rgba): depth = z, intrinsics fitted to the points.
 LoadedFrame LoadPcdFrame(const std::string& path);
 
