@@ -1,9 +1,15 @@
 // Recognition on real data: every YCB-Video frame under ../shared/data through the recognizer with a library
 // of the textured YCB meshes, scored against the ground truth (recall at ADD < 0.1 d, false positives), with
-// and without ICP, and the time per frame split by stage.
+// and without ICP, and the time per frame split by stage. With --peers, the same frames through PCL (FPFH +
+// SampleConsensusPrerejective + ICP) and OpenCV's PPF detector (+ ICP) in the same run; with --lmo-db, the
+// Linemod-Occluded frame (8 vertex-coloured models) as its own table.
 //
 //   scripts/build_ycbv_library /tmp/ycbv.sqlite --views 40 --distance 0.9
-//   recognize_bench --db /tmp/ycbv.sqlite [--results bench/RESULTS.md] [--frames N]
+//   scripts/build_lmo_library /tmp/lmo.sqlite --views 40 --distance 1.0
+//   recognize_bench --db /tmp/ycbv.sqlite [--lmo-db /tmp/lmo.sqlite] [--peers] [--results bench/RESULTS.md]
+//                   [--frames N]
+// --object-pixels also runs the peers on depth cut to the ground-truth objects' own pixels; --peers-only,
+// --frame-step, --ppf-sampling, --ppf-scene-distance and --min-inlier-fraction are for tuning the peers.
 
 #include <algorithm>
 #include <cstring>
@@ -14,13 +20,19 @@
 
 #include "bench_util.h"
 #include "io/frame_io.h"
+#include "recognition_peers.h"
 #include "recognize/evaluation.h"
 #include "recognize/recognizer.h"
 
 namespace ecv::bench {
 namespace {
 
-std::vector<std::string> YcbvFrames(const std::string& data, int limit) {
+struct NamedFrame {
+  std::string name;  // "0001/000001"
+  LoadedFrame frame;
+};
+
+std::vector<NamedFrame> YcbvFrames(const std::string& data, int limit, int step) {
   std::vector<std::string> prefixes;
   for (const auto& video : std::filesystem::directory_iterator(data + "/ycbv_subset/Example-Scenes")) {
     for (const auto& file : std::filesystem::directory_iterator(video.path())) {
@@ -32,37 +44,83 @@ std::vector<std::string> YcbvFrames(const std::string& data, int limit) {
     }
   }
   std::sort(prefixes.begin(), prefixes.end());
+  std::vector<std::string> kept;
+  for (size_t i = 0; i < prefixes.size(); i += static_cast<size_t>(std::max(step, 1))) kept.push_back(prefixes[i]);
+  prefixes = kept;
   if (limit > 0 && static_cast<int>(prefixes.size()) > limit) prefixes.resize(static_cast<size_t>(limit));
-  return prefixes;
+  std::vector<NamedFrame> frames;
+  for (const std::string& prefix : prefixes) {
+    frames.push_back({std::filesystem::path(prefix).parent_path().filename().string() + "/" +
+                          std::filesystem::path(prefix).filename().string(),
+                      LoadYcbvFrame(prefix)});
+  }
+  return frames;
+}
+
+// LM-O test scene 000002, image 3: the one LM-O image with depth (SAM-6D's example depth, see lmo_subset/SOURCE.md).
+std::vector<NamedFrame> LmoFrames(const std::string& data) {
+  const std::string lmo = data + "/lmo_subset";
+  return {{"lmo/000002/000003",
+           LoadBopFrame(lmo + "/data/bop/lmo/test/000002", 3, lmo + "/SAM-6D/Data/Example/depth.png")}};
 }
 
 struct Run {
   std::vector<FrameEvaluation> frames;
-  std::map<std::string, std::vector<double>> stage_ms;
+  std::map<std::string, std::vector<double>> stage_ms;  // "total": the whole frame
 };
+using Runs = std::vector<std::pair<std::string, Run>>;  // in column order
 
-Run RunRecognizer(const ModelLibrary& library, const RecognizerOptions& options, const std::vector<std::string>& frames,
+void Log(const std::string& label, size_t i, size_t n, const FrameEvaluation& evaluation, double ms) {
+  int correct = 0;
+  for (const ObjectEvaluation& object : evaluation.objects) correct += object.correct ? 1 : 0;
+  std::cerr << label << " [" << i + 1 << "/" << n << "] " << evaluation.frame << ": " << correct << " of "
+            << evaluation.objects.size() << " correct, " << evaluation.false_positives << " false positives, "
+            << Fixed(ms, 0) << " ms\n";
+}
+
+Run RunRecognizer(const ModelLibrary& library, const RecognizerOptions& options, const std::vector<NamedFrame>& frames,
                   const std::vector<EvalModel>& models, const std::string& label) {
   Recognizer recognizer(library, options);
   Run run;
   for (size_t i = 0; i < frames.size(); ++i) {
-    const LoadedFrame frame = LoadYcbvFrame(frames[i]);
-    const RecognitionResult result = recognizer.Recognize(frame.rgbd);
-    const std::string name = std::filesystem::path(frames[i]).parent_path().filename().string() + "/" +
-                             std::filesystem::path(frames[i]).filename().string();
-    run.frames.push_back(EvaluateFrame(name, result.detections, frame.ground_truth, models));
+    const RecognitionResult result = recognizer.Recognize(frames[i].frame.rgbd);
+    run.frames.push_back(EvaluateFrame(frames[i].name, result.detections, frames[i].frame.ground_truth, models));
     for (const auto& [stage, ms] : result.timings_ms) run.stage_ms[stage].push_back(ms);
-    int correct = 0;
-    for (const ObjectEvaluation& object : run.frames.back().objects) correct += object.correct ? 1 : 0;
-    std::cerr << label << " [" << i + 1 << "/" << frames.size() << "] " << name << ": " << correct << " of "
-              << run.frames.back().objects.size() << " correct, " << run.frames.back().false_positives
-              << " false positives, " << Fixed(result.timings_ms.at("total"), 0) << " ms\n";
+    Log(label, i, frames.size(), run.frames.back(), result.timings_ms.at("total"));
   }
   return run;
 }
 
-// Per object: frames present, correct, recall; then the totals.
-std::string RecallTable(const std::map<std::string, Run>& runs) {
+Run RunPeer(RecognitionPeer& peer, const std::vector<NamedFrame>& frames, const std::vector<EvalModel>& models,
+            const std::string& label) {
+  Run run;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const PeerResult result = peer.Recognize(frames[i].frame.rgbd);
+    run.frames.push_back(EvaluateFrame(frames[i].name, result.detections, frames[i].frame.ground_truth, models));
+    run.stage_ms["total"].push_back(result.time_ms);
+    run.stage_ms["scene"].push_back(result.scene_ms);
+    run.stage_ms["scene points"].push_back(result.scene_points);
+    Log(label, i, frames.size(), run.frames.back(), result.time_ms);
+    for (const Detection& detection : result.detections) {
+      const auto& objects = run.frames.back().objects;
+      const auto object = std::find_if(objects.begin(), objects.end(),
+                                       [&](const ObjectEvaluation& o) { return o.model == detection.model; });
+      std::cerr << "  " << detection.model << " share " << Fixed(detection.inlier_fraction, 2) << ' '
+                << (object == objects.end() ? "absent"
+                    : object->correct       ? "correct"
+                                            : "wrong");
+      if (object != objects.end()) {
+        std::cerr << " (" << Fixed(object->error.rotation_deg, 0) << " deg, " << Fixed(object->error.translation_mm, 0)
+                  << " mm)";
+      }
+      std::cerr << '\n';
+    }
+  }
+  return run;
+}
+
+// Per object: correct / present; then recall, false positives and the median time per frame.
+std::string RecallTable(const Runs& runs) {
   std::map<std::string, std::map<std::string, std::pair<int, int>>> counts;  // object -> run -> (correct, present)
   std::map<std::string, int> false_positives;
   for (const auto& [label, run] : runs) {
@@ -103,6 +161,11 @@ std::string RecallTable(const std::map<std::string, Run>& runs) {
     out << ' ' << Fixed(static_cast<double>(false_positives[label]) / std::max<size_t>(run.frames.size(), 1), 2)
         << " |";
   }
+  out << "\n| median ms per frame |";
+  for (const auto& [label, run] : runs) {
+    const auto total = run.stage_ms.find("total");
+    out << ' ' << (total == run.stage_ms.end() ? std::string("-") : Fixed(Median(total->second), 0)) << " |";
+  }
   out << '\n';
   return out.str();
 }
@@ -117,50 +180,206 @@ std::string TimingTable(const Run& run) {
   return out.str();
 }
 
+// The peers' inlier share (recognition_peers.h) of every ground-truth pose: what the acceptance threshold must pass.
+std::string GroundTruthInlierShares(const std::vector<PeerModel>& models, const std::vector<NamedFrame>& frames,
+                                    const PeerOptions& options) {
+  std::vector<double> shares;
+  for (const NamedFrame& frame : frames) {
+    const std::vector<Eigen::Vector3f> scene = SceneCloud(frame.frame.rgbd, options.voxel_m);
+    const RadiusGrid grid(scene, static_cast<float>(options.inlier_distance_m));
+    for (const GroundTruth& truth : frame.frame.ground_truth) {
+      for (const PeerModel& model : models) {
+        if (model.name != truth.object_name) continue;
+        std::vector<Eigen::Vector3f> points;
+        VoxelDownsample(model.points, {}, options.voxel_m, &points, nullptr);
+        shares.push_back(InlierFraction(points, truth.camera_from_object, grid));
+      }
+    }
+  }
+  if (shares.empty()) return "";
+  std::sort(shares.begin(), shares.end());
+  const auto below =
+      std::count_if(shares.begin(), shares.end(), [&](double s) { return s < options.min_inlier_fraction; });
+  return "At the ground-truth poses that share is " + Fixed(100 * shares.front(), 0) + " % to " +
+         Fixed(100 * shares.back(), 0) + " % (median " + Fixed(100 * Median(shares), 0) + " %; " +
+         std::to_string(below) + " of " + std::to_string(shares.size()) + " objects below the threshold). ";
+}
+
+// `frame` with depth only where the scene lies within 1 cm of a ground-truth object of `models` (posed by the
+// ground truth): the peers handed the objects' own pixels, to tell their matching from the clutter.
+NamedFrame ObjectPixelsOnly(const NamedFrame& frame, const std::vector<PeerModel>& models) {
+  std::vector<Eigen::Vector3f> posed;
+  for (const GroundTruth& truth : frame.frame.ground_truth) {
+    for (const PeerModel& model : models) {
+      if (model.name != truth.object_name) continue;
+      for (const Eigen::Vector3f& point : model.points) posed.push_back(truth.camera_from_object.cast<float>() * point);
+    }
+  }
+  NamedFrame masked = frame;
+  masked.frame.rgbd.depth = frame.frame.rgbd.depth.clone();
+  const RadiusGrid grid(posed, 0.01F);
+  cv::Mat& depth = masked.frame.rgbd.depth;
+  for (int v = 0; v < depth.rows; ++v) {
+    for (int u = 0; u < depth.cols; ++u) {
+      float& z = depth.at<float>(v, u);
+      if (z <= 0.0F) continue;
+      const Eigen::Vector3f point = frame.frame.rgbd.camera.BackProject(Eigen::Vector2d(u, v), z).cast<float>();
+      if (posed.empty() || grid.NearestWithin(point).first < 0) z = 0.0F;
+    }
+  }
+  return masked;
+}
+
+const char* kPcl = "PCL FPFH + prerejective + ICP";
+const char* kPpf = "OpenCV PPF + ICP";
+
+// Ours with and without ICP and, with `peers`, both peers, on `frames` with the library at `db`.
+Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, bool peers, bool ours, bool object_pixels,
+            const PeerOptions& peer_options, std::ostringstream* notes) {
+  LibraryLoadOptions load;
+  load.build_matchers = false;
+  const ModelLibrary library = ModelLibrary::Load(db, load);
+  std::vector<EvalModel> models;
+  for (const LibraryModel& model : library.models()) models.push_back(EvalModelFromRecord(model.record));
+  *notes << "Library: " << library.models().size() << " models, " << library.NumViews() << " views (`" << db
+         << "`); models with a colour matrix: "
+         << std::count_if(library.models().begin(), library.models().end(),
+                          [](const LibraryModel& model) { return model.color_matrix.has_value(); })
+         << ". ";
+  Runs runs;
+  RecognizerOptions options;
+  if (ours) {
+    runs.emplace_back("ECV + RANSAC + ICP", RunRecognizer(library, options, frames, models, "icp"));
+    options.refine = false;
+    runs.emplace_back("ECV + RANSAC (no ICP)", RunRecognizer(library, options, frames, models, "no icp"));
+  }
+  if (!peers) return runs;
+  std::vector<PeerModel> peer_models;
+  for (const LibraryModel& model : library.models()) peer_models.push_back(SamplePeerModel(model.record));
+  *notes << GroundTruthInlierShares(peer_models, frames, peer_options);
+  auto start = Clock::now();
+  const std::unique_ptr<RecognitionPeer> pcl = MakePclPeer(peer_models, peer_options);
+  const double pcl_setup_ms = MillisecondsSince(start);
+  runs.emplace_back(kPcl, RunPeer(*pcl, frames, models, "pcl"));
+  start = Clock::now();
+  const std::unique_ptr<RecognitionPeer> ppf = MakePpfPeer(peer_models, peer_options);
+  const double ppf_setup_ms = MillisecondsSince(start);
+  runs.emplace_back(kPpf, RunPeer(*ppf, frames, models, "ppf"));
+  if (object_pixels) {
+    std::vector<NamedFrame> masked;
+    for (const NamedFrame& frame : frames) masked.push_back(ObjectPixelsOnly(frame, peer_models));
+    runs.emplace_back(std::string(kPcl) + ", objects' pixels only", RunPeer(*pcl, masked, models, "pcl objects"));
+    runs.emplace_back(std::string(kPpf) + ", objects' pixels only", RunPeer(*ppf, masked, models, "ppf objects"));
+  }
+  const Run& pcl_run = runs[ours ? 2 : 0].second;
+  const Run& ppf_run = runs[ours ? 3 : 1].second;
+  *notes << "Peers: model set-up (voxel grid, PCL normals + FPFH) " << Fixed(pcl_setup_ms, 0)
+         << " ms for PCL, PPF training " << Fixed(ppf_setup_ms, 0) << " ms for OpenCV, not in the times per frame; "
+         << "scene cloud " << Fixed(Median(pcl_run.stage_ms.at("scene points")), 0)
+         << " points (median), its normals and features " << Fixed(Median(pcl_run.stage_ms.at("scene")), 0)
+         << " ms (PCL), " << Fixed(Median(ppf_run.stage_ms.at("scene")), 0) << " ms (OpenCV) per frame. ";
+  return runs;
+}
+
+std::string PeerSettings(const PeerOptions& o) {
+  std::ostringstream out;
+  out << "Peers, whole frame (no masks, no ground truth), geometry only, one thread: model = points sampled on the "
+         "mesh surface (2 mm apart, area-weighted, seed 1) with the triangles' normals; scene = every depth pixel; "
+         "both on a "
+      << Fixed(o.voxel_m * 1000, 0) << " mm voxel grid. PCL: normals by PCL (radius "
+      << Fixed(o.normal_radius_m * 1000, 0) << " mm; model normals turned to agree with the mesh's), FPFH radius "
+      << Fixed(o.fpfh_radius_m * 1000, 0) << " mm, SampleConsensusPrerejective (" << o.pcl_iterations
+      << " iterations, 3 samples, correspondence randomness " << o.pcl_correspondence_randomness << ", similarity "
+      << Fixed(o.pcl_similarity, 2) << ", inlier distance " << Fixed(o.inlier_distance_m * 1000, 0)
+      << " mm, inlier fraction " << Fixed(o.min_inlier_fraction, 2) << ", std::srand(" << o.seed
+      << ") per model), then IterativeClosestPoint (" << o.icp_iterations << " iterations, "
+      << Fixed(o.inlier_distance_m * 1000, 0) << " mm). OpenCV: PPF3DDetector(relative sampling "
+      << Fixed(o.ppf_relative_sampling, 3) << ", relative distance " << Fixed(o.ppf_relative_distance, 3)
+      << ") trained on the voxelised model with its normals; match(scene sample step 1/"
+      << Fixed(1.0 / o.ppf_scene_sample_step, 0) << ", relative scene distance " << Fixed(o.ppf_scene_distance, 3)
+      << ") on the voxelised scene with computeNormalsPC3d (" << o.ppf_normal_neighbours
+      << " neighbours, turned to the camera); the most voted pose, its rotation made rigid (OpenCV 4.6 returns it "
+         "scaled: the pose cluster's quaternions are averaged without normalising), refined with ppf_match_3d::ICP ("
+      << o.icp_iterations
+      << " iterations) on the scene points within one model diameter, kept unless it lowers the inlier share. Both "
+         "peers report a model when, after ICP, at least "
+      << Fixed(100 * o.min_inlier_fraction, 0) << " % of its voxelised points lie within "
+      << Fixed(o.inlier_distance_m * 1000, 0)
+      << " mm of a scene point (score = that share); at most one detection per model.\n";
+  return out.str();
+}
+
 }  // namespace
 }  // namespace ecv::bench
 
 int main(int argc, char** argv) {
   using namespace ecv;
   using namespace ecv::bench;
-  std::string db, results = std::string(ECV_SOURCE_DIR) + "/bench/RESULTS.md";
-  int limit = 0;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    if (std::strcmp(argv[i], "--db") == 0) db = argv[i + 1];
-    if (std::strcmp(argv[i], "--results") == 0) results = argv[i + 1];
-    if (std::strcmp(argv[i], "--frames") == 0) limit = std::atoi(argv[i + 1]);
+  std::string db, lmo_db, results = std::string(ECV_SOURCE_DIR) + "/bench/RESULTS.md";
+  int limit = 0, step = 1;
+  bool peers = false, ours = true, object_pixels = false;
+  PeerOptions peer_options;
+  for (int i = 1; i < argc; ++i) {
+    const bool has_value = i + 1 < argc;
+    if (std::strcmp(argv[i], "--peers") == 0) {
+      peers = true;
+    } else if (std::strcmp(argv[i], "--peers-only") == 0) {  // for tuning the peers
+      peers = true;
+      ours = false;
+    } else if (std::strcmp(argv[i], "--object-pixels") == 0) {  // peers also on the objects' pixels only
+      object_pixels = true;
+    } else if (has_value && std::strcmp(argv[i], "--frame-step") == 0) {
+      step = std::atoi(argv[++i]);
+    } else if (has_value && std::strcmp(argv[i], "--ppf-sampling") == 0) {
+      peer_options.ppf_relative_sampling = std::atof(argv[++i]);
+    } else if (has_value && std::strcmp(argv[i], "--ppf-scene-distance") == 0) {
+      peer_options.ppf_scene_distance = std::atof(argv[++i]);
+    } else if (has_value && std::strcmp(argv[i], "--min-inlier-fraction") == 0) {
+      peer_options.min_inlier_fraction = std::atof(argv[++i]);
+    } else if (has_value && std::strcmp(argv[i], "--db") == 0) {
+      db = argv[++i];
+    } else if (has_value && std::strcmp(argv[i], "--lmo-db") == 0) {
+      lmo_db = argv[++i];
+    } else if (has_value && std::strcmp(argv[i], "--results") == 0) {
+      results = argv[++i];
+    } else if (has_value && std::strcmp(argv[i], "--frames") == 0) {
+      limit = std::atoi(argv[++i]);
+    } else {
+      db.clear();
+      break;
+    }
   }
   if (db.empty()) {
-    std::cerr << "usage: recognize_bench --db LIB.sqlite [--results FILE] [--frames N]\n"
-                 "  (build the library with scripts/build_ycbv_library LIB.sqlite --views 40 --distance 0.9)\n";
+    std::cerr
+        << "usage: recognize_bench --db LIB.sqlite [--lmo-db LMO.sqlite] [--peers | --peers-only] [--object-pixels]\n"
+           "         [--results FILE] [--frames N] [--frame-step S] [--ppf-sampling R] [--ppf-scene-distance R]\n"
+           "         [--min-inlier-fraction F]\n"
+           "  (build the libraries with scripts/build_ycbv_library LIB.sqlite --views 40 --distance 0.9 and\n"
+           "   scripts/build_lmo_library LMO.sqlite --views 40 --distance 1.0)\n";
     return 2;
   }
   try {
-    LibraryLoadOptions load;
-    load.build_matchers = false;
-    const ModelLibrary library = ModelLibrary::Load(db, load);
-    std::vector<EvalModel> models;
-    for (const LibraryModel& model : library.models()) models.push_back(EvalModelFromRecord(model.record));
-    const std::vector<std::string> frames = YcbvFrames(ECV_DATA_DIR, limit);
-
-    std::map<std::string, Run> runs;
-    RecognizerOptions options;
-    runs["ECV + RANSAC + ICP"] = RunRecognizer(library, options, frames, models, "icp");
-    options.refine = false;
-    runs["ECV + RANSAC (no ICP)"] = RunRecognizer(library, options, frames, models, "no icp");
-
-    std::ostringstream markdown;
-    markdown << "Library: " << library.models().size() << " textured YCB meshes, " << library.NumViews() << " views (`"
-             << db << "`); " << frames.size()
-             << " YCB-Video frames (videos 0000-0002). Correct = ADD < 0.1 x diameter; a false positive is a "
-                "detection of a model not in the frame or a wrong pose. Models with a colour matrix (applied to "
-                "their colours before matching and in verification): "
-             << std::count_if(library.models().begin(), library.models().end(),
-                              [](const LibraryModel& model) { return model.color_matrix.has_value(); })
-             << ".\n\n"
-             << RecallTable(runs) << "\nTime per frame, whole library (ECV + RANSAC + ICP):\n\n"
-             << TimingTable(runs["ECV + RANSAC + ICP"]);
-    Report(results, "Recognition on YCB-Video (recognize_bench)", CommandLine(argc, argv), markdown.str());
+    peer_options.Check();
+    std::ostringstream markdown, notes;
+    const std::vector<NamedFrame> frames = YcbvFrames(ECV_DATA_DIR, limit, step);
+    const Runs runs = RunAll(db, frames, peers, ours, object_pixels, peer_options, &notes);
+    markdown << notes.str() << frames.size()
+             << " YCB-Video frames (videos 0000-0002). Correct = ADD < 0.1 x diameter (ADD-S for symmetric models); "
+                "a false positive is a detection of a model not in the frame or a wrong pose.\n\n"
+             << RecallTable(runs);
+    if (ours)
+      markdown << "\nTime per frame, whole library (ECV + RANSAC + ICP):\n\n" << TimingTable(runs.front().second);
+    if (!lmo_db.empty()) {
+      std::ostringstream lmo_notes;
+      const Runs lmo_runs =
+          RunAll(lmo_db, LmoFrames(ECV_DATA_DIR), peers, ours, object_pixels, peer_options, &lmo_notes);
+      markdown << "\nLinemod-Occluded, scene 000002 image 3 (Kinect v1, 8 vertex-coloured models, eggbox and glue "
+                  "judged by ADD-S). "
+               << lmo_notes.str() << "\n\n"
+               << RecallTable(lmo_runs);
+    }
+    if (peers) markdown << '\n' << PeerSettings(peer_options);
+    Report(results, "Recognition on YCB-Video and LM-O (recognize_bench)", CommandLine(argc, argv), markdown.str());
   } catch (const std::exception& error) {
     std::cerr << "recognize_bench: " << error.what() << '\n';
     return 1;

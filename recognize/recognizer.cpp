@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numeric>
+#include <random>
 
 #include <opencv2/imgproc.hpp>
 
@@ -29,6 +30,7 @@ struct Scene {
   Descriptors descriptors;
   std::unique_ptr<DescriptorMatcher> matcher;
   std::vector<Eigen::Vector3f> points;  // primitive positions first, then the dense depth points
+  cv::Mat color;                        // the frame's colours, as verification compares them
   SceneVisibility visibility;
 };
 
@@ -64,12 +66,129 @@ LibraryIndex BuildVoteIndex(const std::vector<ModelRecord>& records, size_t firs
   return index;
 }
 
-// A model view ranked by its distinctive matches, with the correspondences for RANSAC.
+// A model view ranked by its votes or its consistent correspondences, with the correspondences for RANSAC.
 struct ViewCandidate {
   int view = -1;
-  int votes = 0;
+  int score = 0;
   std::vector<Correspondence> correspondences;
 };
+
+// At most `count` rows of `descriptors`, drawn at random (seeded) when there are more.
+Descriptors SampleRows(const Descriptors& descriptors, size_t count, uint64_t seed) {
+  const size_t rows = static_cast<size_t>(descriptors.values.rows);
+  if (rows <= count) return descriptors;
+  std::vector<int> order(rows);
+  std::iota(order.begin(), order.end(), 0);
+  std::mt19937_64 random(seed);
+  std::shuffle(order.begin(), order.end(), random);
+  order.resize(count);
+  std::sort(order.begin(), order.end());
+  Descriptors subset;
+  subset.values.create(static_cast<int>(count), descriptors.values.cols, descriptors.values.type());
+  for (size_t i = 0; i < count; ++i) {
+    descriptors.values.row(order[i]).copyTo(subset.values.row(static_cast<int>(i)));
+    subset.primitive.push_back(descriptors.primitive[static_cast<size_t>(order[i])]);
+  }
+  return subset;
+}
+
+// Whether two correspondences can both be true: their object and scene primitives lie equally far apart
+// (within `tolerance_m`, and at least 2 cm so the distance says something; at most `max_distance_m`), and
+// the |cosines| between their orientations and the line joining them agree within `angle_tolerance`.
+bool Consistent(const Primitive& object_a, const Primitive& scene_a, const Primitive& object_b,
+                const Primitive& scene_b, float max_distance_m, float tolerance_m, float angle_tolerance) {
+  constexpr float kMinDistance = 0.02F;
+  Eigen::Vector3f object_line = object_b.position - object_a.position;
+  Eigen::Vector3f scene_line = scene_b.position - scene_a.position;
+  const float object_distance = object_line.norm(), scene_distance = scene_line.norm();
+  if (object_distance < kMinDistance || object_distance > max_distance_m ||
+      std::abs(object_distance - scene_distance) > tolerance_m) {
+    return false;
+  }
+  object_line /= object_distance;
+  scene_line /= scene_distance;
+  auto agree = [&](const Eigen::Vector3f& a, const Eigen::Vector3f& b, const Eigen::Vector3f& c,
+                   const Eigen::Vector3f& d) {
+    return std::abs(std::abs(a.dot(b)) - std::abs(c.dot(d))) <= angle_tolerance;
+  };
+  return agree(object_a.orientation, object_b.orientation, scene_a.orientation, scene_b.orientation) &&
+         agree(object_a.orientation, object_line, scene_a.orientation, scene_line) &&
+         agree(object_b.orientation, object_line, scene_b.orientation, scene_line);
+}
+
+// The size of a large set of pairwise-consistent correspondences, grown greedily from each one in turn
+// (its consistent partners taken by how many of the others they agree with).
+int ConsistentSetSize(const std::vector<Primitive>& object, const std::vector<Primitive>& scene,
+                      const std::vector<Correspondence>& correspondences, float max_distance_m, float tolerance_m,
+                      float angle_tolerance) {
+  const size_t n = correspondences.size();
+  std::vector<std::vector<int>> partners(n);
+  std::vector<char> agree(n * n, 0);
+  for (size_t a = 0; a < n; ++a) {
+    const Primitive& object_a = object[static_cast<size_t>(correspondences[a].object)];
+    const Primitive& scene_a = scene[static_cast<size_t>(correspondences[a].scene)];
+    for (size_t b = a + 1; b < n; ++b) {
+      if (!Consistent(object_a, scene_a, object[static_cast<size_t>(correspondences[b].object)],
+                      scene[static_cast<size_t>(correspondences[b].scene)], max_distance_m, tolerance_m,
+                      angle_tolerance)) {
+        continue;
+      }
+      agree[a * n + b] = agree[b * n + a] = 1;
+      partners[a].push_back(static_cast<int>(b));
+      partners[b].push_back(static_cast<int>(a));
+    }
+  }
+  int best = n > 0 ? 1 : 0;
+  for (size_t a = 0; a < n; ++a) {
+    if (static_cast<int>(partners[a].size()) < best) continue;  // cannot grow a larger set
+    std::vector<int>& candidates = partners[a];
+    std::vector<int> degree(candidates.size(), 0);
+    for (size_t x = 0; x < candidates.size(); ++x) {
+      for (const int y : candidates)
+        degree[x] += agree[static_cast<size_t>(candidates[x]) * n + static_cast<size_t>(y)];
+    }
+    std::vector<size_t> order(candidates.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(), [&](size_t x, size_t y) { return degree[x] > degree[y]; });
+    std::vector<int> set;
+    for (const size_t x : order) {
+      const int candidate = candidates[x];
+      if (std::all_of(set.begin(), set.end(), [&](int member) {
+            return agree[static_cast<size_t>(member) * n + static_cast<size_t>(candidate)] != 0;
+          })) {
+        set.push_back(candidate);
+      }
+    }
+    best = std::max(best, static_cast<int>(set.size()) + 1);
+  }
+  return best;
+}
+
+// Normalised cross-correlation of (model, scene) colour pairs, per channel, averaged and clipped to [0, 1]:
+// high when the model's texture lies where the scene shows it, whatever the gain and offset of the light.
+double ColorCorrelation(const std::vector<std::pair<Eigen::Vector3f, Eigen::Vector3f>>& colors) {
+  constexpr size_t kMinPixels = 10;
+  if (colors.size() < kMinPixels) return 0.0;
+  Eigen::Vector3f model_mean = Eigen::Vector3f::Zero(), scene_mean = Eigen::Vector3f::Zero();
+  for (const auto& [model, scene] : colors) {
+    model_mean += model;
+    scene_mean += scene;
+  }
+  model_mean /= static_cast<float>(colors.size());
+  scene_mean /= static_cast<float>(colors.size());
+  Eigen::Vector3f cross = Eigen::Vector3f::Zero(), model_variance = cross, scene_variance = cross;
+  for (const auto& [model, scene] : colors) {
+    const Eigen::Vector3f a = model - model_mean, b = scene - scene_mean;
+    cross += a.cwiseProduct(b);
+    model_variance += a.cwiseProduct(a);
+    scene_variance += b.cwiseProduct(b);
+  }
+  double correlation = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    correlation += cross[k] / std::sqrt(std::max(1e-9F, model_variance[k] * scene_variance[k])) / 3.0;
+  }
+  return std::max(0.0, correlation);
+}
 
 // A pose hypothesis of a model from one of its views.
 struct Hypothesis {
@@ -87,6 +206,12 @@ RansacOptions RecognizerOptions::DefaultRansac() {
   return options;
 }
 
+MatchOptions RecognizerOptions::DefaultMatch() {
+  MatchOptions options;
+  options.checks = 32;
+  return options;
+}
+
 void RecognizerOptions::Check() const {
   match.Check();
   ransac.Check();
@@ -96,9 +221,15 @@ void RecognizerOptions::Check() const {
   };
   require(views_per_model >= 1, "views_per_model", "at least 1");
   require(ratio_test > 0.0 && ratio_test <= 1.0, "ratio_test", "in (0, 1]");
+  require(consistency_tolerance_m > 0.0, "consistency_tolerance_m", "> 0 m");
+  require(consistency_angle_tolerance > 0.0, "consistency_angle_tolerance", "> 0");
+  require(consistency_max_correspondences >= 3, "consistency_max_correspondences", "at least 3");
   require(dense_stride_px >= 1, "dense_stride_px", "at least 1");
+  require(sample_radius_diameters >= 0.0, "sample_radius_diameters", ">= 0 (0: sample anywhere)");
   require(depth_tolerance_m > 0.0, "depth_tolerance_m", "> 0 m");
-  require(color_tolerance > 0.0, "color_tolerance", "> 0");
+  require(scene_max_neighbours >= 0, "scene_max_neighbours", ">= 0 (0: the library's setting)");
+  require(max_overlap >= 0.0 && max_overlap <= 1.0, "max_overlap", "in [0, 1]");
+  require(color_blur_px >= 0.0, "color_blur_px", ">= 0 pixels");
   require(min_score >= 0.0 && min_score <= 1.0, "min_score", "in [0, 1]");
   require(min_visible_fraction >= 0.0 && min_visible_fraction <= 1.0, "min_visible_fraction", "in [0, 1]");
 }
@@ -107,7 +238,8 @@ class Recognizer::Impl {
  public:
   Impl(const ModelLibrary& library, const RecognizerOptions& options) : library_(library), options_(options) {
     options_.Check();
-    options_.match.k = 2;
+    const bool votes = options_.view_ranking == RecognizerOptions::ViewRanking::kVotes;
+    options_.match.k = votes ? 2 : 1;  // votes need the second nearest for their ratio test
     for (const LibraryModel& model : library_.models()) {
       // With a colour matrix, the views' colours are mapped into the scene camera's colours and their
       // descriptors recomputed (paper Sect. IV-C: A c_model = c_scene before matching).
@@ -125,6 +257,7 @@ class Recognizer::Impl {
       load.allow_missing_textures = true;
       meshes_.push_back(renderer_.AddMesh(LoadMesh(record.mesh_path, load)));
     }
+    if (!votes) return;
     if (options_.library_wide_votes) {
       vote_indices_.push_back(BuildVoteIndex(records_, 0, records_.size(), options_.match));
     } else {
@@ -141,6 +274,7 @@ class Recognizer::Impl {
     Clock::time_point stage = Clock::now();
     const std::vector<std::vector<int>> votes = CountVotes(scene);
     result.timings_ms["match"] += MillisecondsSince(stage);
+    std::vector<std::pair<size_t, Detection>> candidates;  // (model, its best detection)
     for (size_t m = 0; m < library_.models().size(); ++m) {
       stage = Clock::now();
       const std::vector<ViewCandidate> views = RankViews(m, votes[m], scene);
@@ -175,10 +309,11 @@ class Recognizer::Impl {
       if (best && (best->score < options_.min_score || best->visible_fraction < options_.min_visible_fraction)) {
         best.reset();
       }
-      if (best) result.detections.push_back(*best);
+      if (best) candidates.emplace_back(m, *best);
     }
-    std::sort(result.detections.begin(), result.detections.end(),
-              [](const Detection& a, const Detection& b) { return a.score > b.score; });
+    stage = Clock::now();
+    result.detections = SuppressOverlaps(scene, std::move(candidates));
+    result.timings_ms["verify"] += MillisecondsSince(stage);
     result.timings_ms["total"] = MillisecondsSince(start);
     return result;
   }
@@ -194,7 +329,12 @@ class Recognizer::Impl {
     result->timings_ms["extract"] = MillisecondsSince(stage);
 
     stage = Clock::now();
-    scene.descriptors = ComputeDescriptors(scene.primitives, settings.descriptor);
+    DescriptorOptions describe = settings.descriptor;
+    if (options_.scene_max_neighbours > 0 &&
+        (describe.max_neighbours == 0 || describe.max_neighbours > options_.scene_max_neighbours)) {
+      describe.max_neighbours = options_.scene_max_neighbours;
+    }
+    scene.descriptors = ComputeDescriptors(scene.primitives, describe);
     if (scene.descriptors.values.rows > 0) {
       scene.matcher = std::make_unique<DescriptorMatcher>(scene.primitives, scene.descriptors, options_.match);
     }
@@ -208,6 +348,9 @@ class Recognizer::Impl {
         if (z > 0.0F) scene.points.push_back(frame.camera.BackProject({u, v}, z).cast<float>());
       }
     }
+    scene.color = frame.color;
+    if (options_.color_blur_px > 0.0)
+      cv::GaussianBlur(frame.color, scene.color, cv::Size(0, 0), options_.color_blur_px);
     scene.visibility.depth = frame.depth;
     scene.visibility.camera = frame.camera;
     return scene;
@@ -235,41 +378,62 @@ class Recognizer::Impl {
     return votes;
   }
 
-  // The model's views with the most votes, each with its correspondences: the nearest scene descriptor of
-  // each of its descriptors (paper: object to scene).
+  // The model's best-ranked views, each with its correspondences: the nearest scene descriptor of each of
+  // its descriptors (paper: object to scene).
   std::vector<ViewCandidate> RankViews(size_t model, const std::vector<int>& votes, const Scene& scene) const {
     std::vector<ViewCandidate> views;
     if (!scene.matcher) return views;
     const ModelRecord& record = records_[model];
-    std::vector<int> order(record.views.size());
-    std::iota(order.begin(), order.end(), 0);
-    std::stable_sort(order.begin(), order.end(),
-                     [&](int a, int b) { return votes[static_cast<size_t>(a)] > votes[static_cast<size_t>(b)]; });
-    order.resize(std::min(order.size(), static_cast<size_t>(options_.views_per_model)));
-    for (const int v : order) {
-      const ModelView& view = record.views[static_cast<size_t>(v)];
+    const bool by_votes = options_.view_ranking == RecognizerOptions::ViewRanking::kVotes;
+    for (size_t v = 0; v < record.views.size(); ++v) {
+      const ModelView& view = record.views[v];
       if (view.descriptors.values.rows == 0) continue;
       ViewCandidate candidate;
-      candidate.view = v;
-      candidate.votes = votes[static_cast<size_t>(v)];
-      for (const DescriptorMatch& match : scene.matcher->Match(view.primitives, view.descriptors)) {
-        if (match.rank == 0) candidate.correspondences.push_back({match.query, match.train});
+      candidate.view = static_cast<int>(v);
+      if (by_votes) {
+        candidate.score = votes[v];
+      } else {  // scored on a seeded subset of the view's descriptors, for speed
+        const Descriptors subset = SampleRows(
+            view.descriptors, static_cast<size_t>(options_.consistency_max_correspondences), options_.ransac.seed + v);
+        candidate.score = ConsistentSetSize(view.primitives, scene.primitives, Correspondences(view, subset, scene),
+                                            static_cast<float>(record.diameter_m),
+                                            static_cast<float>(options_.consistency_tolerance_m),
+                                            static_cast<float>(options_.consistency_angle_tolerance));
       }
       views.push_back(std::move(candidate));
     }
+    std::stable_sort(views.begin(), views.end(),
+                     [](const ViewCandidate& a, const ViewCandidate& b) { return a.score > b.score; });
+    views.resize(std::min(views.size(), static_cast<size_t>(options_.views_per_model)));
+    for (ViewCandidate& candidate : views) {
+      const ModelView& view = record.views[static_cast<size_t>(candidate.view)];
+      candidate.correspondences = Correspondences(view, view.descriptors, scene);
+    }
     return views;
+  }
+
+  // The nearest scene primitive of each of `descriptors` (rows of the view's).
+  static std::vector<Correspondence> Correspondences(const ModelView& view, const Descriptors& descriptors,
+                                                     const Scene& scene) {
+    std::vector<Correspondence> found;
+    for (const DescriptorMatch& match : scene.matcher->Match(view.primitives, descriptors)) {
+      if (match.rank == 0) found.push_back({match.query, match.train});
+    }
+    return found;
   }
 
   std::vector<Hypothesis> EstimatePoses(const ModelRecord& model, const std::vector<ViewCandidate>& views,
                                         const Scene& scene) const {
     std::vector<Hypothesis> hypotheses;
+    RansacOptions ransac = options_.ransac;
+    ransac.sample_radius_m = options_.sample_radius_diameters * model.diameter_m;
     for (const ViewCandidate& candidate : views) {
       const ModelView& view = model.views[static_cast<size_t>(candidate.view)];
       const std::vector<Eigen::Vector3f> object_points = PrimitivePositions(view.primitives);
       Hypothesis hypothesis;
       hypothesis.view = candidate.view;
-      hypothesis.ransac = EstimatePoseRansac(object_points, scene.points, candidate.correspondences, options_.ransac,
-                                             &scene.visibility);
+      hypothesis.ransac =
+          EstimatePoseRansac(object_points, scene.points, candidate.correspondences, ransac, &scene.visibility);
       hypothesis.pose = hypothesis.ransac.scene_from_object;
       if (hypothesis.ransac.success) hypotheses.push_back(hypothesis);
     }
@@ -303,10 +467,45 @@ class Recognizer::Impl {
     if (icp.success) hypothesis->pose = icp.scene_from_object;
   }
 
+  // The detections, best first, without those whose rendered surface lies mostly (max_overlap) on scene
+  // pixels that a better detection of another model already explains: one surface, one object.
+  std::vector<Detection> SuppressOverlaps(const Scene& scene, std::vector<std::pair<size_t, Detection>> candidates) {
+    std::stable_sort(candidates.begin(), candidates.end(),
+                     [](const auto& a, const auto& b) { return a.second.score > b.second.score; });
+    const cv::Mat& scene_depth = scene.frame->depth;
+    cv::Mat explained = cv::Mat::zeros(scene_depth.size(), CV_8UC1);
+    std::vector<Detection> kept;
+    for (const auto& [model, detection] : candidates) {
+      const RenderResult rendered = renderer_.Render(meshes_[model], scene.frame->camera, detection.camera_from_object);
+      std::vector<cv::Point> surface;  // the model's pixels on the scene surface
+      for (int v = 0; v < rendered.depth.rows; v += options_.dense_stride_px) {
+        for (int u = 0; u < rendered.depth.cols; u += options_.dense_stride_px) {
+          const float model_z = rendered.depth.at<float>(v, u), scene_z = scene_depth.at<float>(v, u);
+          if (model_z > 0.0F && scene_z > 0.0F &&
+              std::abs(scene_z - model_z) <= static_cast<float>(options_.depth_tolerance_m)) {
+            surface.emplace_back(u, v);
+          }
+        }
+      }
+      const auto taken = std::count_if(surface.begin(), surface.end(),
+                                       [&](const cv::Point& p) { return explained.at<uchar>(p) != 0; });
+      if (!surface.empty() && static_cast<double>(taken) > options_.max_overlap * static_cast<double>(surface.size())) {
+        continue;
+      }
+      for (const cv::Point& p : surface) explained.at<uchar>(p) = 1;
+      kept.push_back(detection);
+    }
+    return kept;
+  }
+
   Detection Verify(size_t model, const Scene& scene, const Hypothesis& hypothesis) {
     const LibraryModel& library_model = library_.models()[model];
     const RgbdFrame& frame = *scene.frame;
     const RenderResult rendered = renderer_.Render(meshes_[model], frame.camera, hypothesis.pose);
+    cv::Mat model_color = rendered.color;
+    if (options_.color_blur_px > 0.0) {
+      cv::GaussianBlur(rendered.color, model_color, cv::Size(0, 0), options_.color_blur_px);
+    }
     Eigen::Matrix3f to_scene = Eigen::Matrix3f::Identity();
     if (options_.use_color_matrix && library_model.color_matrix) {
       to_scene = library_model.color_matrix->model_to_scene.cast<float>();
@@ -324,25 +523,14 @@ class Recognizer::Impl {
         ++visible;
         if (std::abs(scene_z - model_z) > tolerance) continue;
         ++on_surface;
-        const cv::Vec3b& m = rendered.color.at<cv::Vec3b>(v, u);
-        const cv::Vec3b& s = frame.color.at<cv::Vec3b>(v, u);
+        const cv::Vec3b& m = model_color.at<cv::Vec3b>(v, u);
+        const cv::Vec3b& s = scene.color.at<cv::Vec3b>(v, u);
         colors.emplace_back(to_scene * Eigen::Vector3f(m[0], m[1], m[2]) / 255.0F,
                             Eigen::Vector3f(s[0], s[1], s[2]) / 255.0F);
       }
     }
-    // Colours compared after one gain (scene brightness over model brightness, 0.5 .. 2): exposure and
-    // light level differ between the texture capture and the scene even when the colours are right.
-    float model_sum = 0.0F, scene_sum = 0.0F;
-    for (const auto& [m, s] : colors) {
-      model_sum += m.sum();
-      scene_sum += s.sum();
-    }
-    const float gain = model_sum > 0.0F ? std::clamp(scene_sum / model_sum, 0.5F, 2.0F) : 1.0F;
-    const auto same_color = std::count_if(colors.begin(), colors.end(), [&](const auto& pair) {
-      return (gain * pair.first - pair.second).norm() < static_cast<float>(options_.color_tolerance);
-    });
-
     Detection detection;
+    detection.color_agreement = ColorCorrelation(colors);
     detection.model = library_model.record.name;
     detection.camera_from_object = hypothesis.pose;
     detection.inlier_fraction = hypothesis.ransac.inlier_fraction;
@@ -350,7 +538,6 @@ class Recognizer::Impl {
     detection.view = hypothesis.view;
     detection.visible_fraction = rendered_pixels > 0 ? static_cast<double>(visible) / rendered_pixels : 0.0;
     detection.depth_agreement = visible > 0 ? static_cast<double>(on_surface) / visible : 0.0;
-    detection.color_agreement = on_surface > 0 ? static_cast<double>(same_color) / on_surface : 0.0;
     detection.score = detection.depth_agreement * detection.color_agreement;
     return detection;
   }

@@ -81,6 +81,7 @@ class Estimator {
     std::iota(order_.begin(), order_.end(), 0);
     std::mt19937_64 random(options.seed);
     std::shuffle(order_.begin(), order_.end(), random);
+    if (options.sample_radius_m > 0.0) FindSampleNeighbours();
   }
 
   struct Best {
@@ -117,16 +118,17 @@ class Estimator {
     std::seed_seq seeds{static_cast<uint32_t>(options_.seed), static_cast<uint32_t>(options_.seed >> 32U),
                         static_cast<uint32_t>(block)};
     std::mt19937_64 random(seeds);
-    std::uniform_int_distribution<size_t> pick(0, correspondences_.size() - 1);
     const size_t n = static_cast<size_t>(options_.sample_size);
     std::vector<Eigen::Vector3f> object_sample(n), scene_sample(n);
     const PolygonEdgeCheck polygon(options_.polygon_threshold);
     Inliers inliers;
     BlockOutcome outcome;
+    std::vector<int> sample(n);
     while (outcome.iterations < size) {
       ++outcome.iterations;
+      if (!DrawSample(random, &sample)) continue;
       for (size_t k = 0; k < n; ++k) {
-        const Correspondence& c = correspondences_[pick(random)];
+        const Correspondence& c = correspondences_[static_cast<size_t>(sample[k])];
         object_sample[k] = object_[static_cast<size_t>(c.object)];
         scene_sample[k] = scene_[static_cast<size_t>(c.scene)];
       }
@@ -155,6 +157,50 @@ class Estimator {
   }
 
  private:
+  // Indices of a sample's correspondences: uniform over all (the paper), or the first uniform and the
+  // others among its neighbours (sample_radius_m). False when the first one has too few neighbours.
+  bool DrawSample(std::mt19937_64& random, std::vector<int>* sample) const {
+    const size_t n = sample->size();
+    if (neighbours_.empty()) {
+      std::uniform_int_distribution<int> pick(0, static_cast<int>(correspondences_.size()) - 1);
+      for (int& index : *sample) index = pick(random);
+      return true;
+    }
+    std::uniform_int_distribution<size_t> pick(0, correspondences_.size() - 1);
+    const size_t first = pick(random);
+    const std::vector<int>& near = neighbours_[first];
+    if (near.size() < n - 1) return false;
+    (*sample)[0] = static_cast<int>(first);
+    std::uniform_int_distribution<size_t> pick_near(0, near.size() - 1);
+    for (size_t k = 1; k < n; ++k) {
+      int index = 0;
+      do {  // distinct from the ones drawn before (near.size() >= n - 1, so this ends)
+        index = near[pick_near(random)];
+      } while (std::find(sample->begin() + 1, sample->begin() + static_cast<std::ptrdiff_t>(k), index) !=
+               sample->begin() + static_cast<std::ptrdiff_t>(k));
+      (*sample)[k] = index;
+    }
+    return true;
+  }
+
+  // For each correspondence, the others whose object and scene points both lie within sample_radius_m.
+  void FindSampleNeighbours() {
+    const float radius_squared = static_cast<float>(options_.sample_radius_m * options_.sample_radius_m);
+    neighbours_.resize(correspondences_.size());
+    for (size_t i = 0; i < correspondences_.size(); ++i) {
+      const Eigen::Vector3f& object_i = object_[static_cast<size_t>(correspondences_[i].object)];
+      const Eigen::Vector3f& scene_i = scene_[static_cast<size_t>(correspondences_[i].scene)];
+      for (size_t j = i + 1; j < correspondences_.size(); ++j) {
+        if ((scene_[static_cast<size_t>(correspondences_[j].scene)] - scene_i).squaredNorm() > radius_squared ||
+            (object_[static_cast<size_t>(correspondences_[j].object)] - object_i).squaredNorm() > radius_squared) {
+          continue;
+        }
+        neighbours_[i].push_back(static_cast<int>(j));
+        neighbours_[j].push_back(static_cast<int>(i));
+      }
+    }
+  }
+
   // Fills `inliers` for `pose`; false as soon as the required fraction can no longer be reached.
   bool FindInliers(const Eigen::Isometry3d& pose, Inliers* inliers) const {
     const Eigen::Isometry3f transform = pose.cast<float>();
@@ -199,7 +245,8 @@ class Estimator {
   const RansacOptions& options_;
   const SceneVisibility* visibility_;
   const RadiusGrid tree_;
-  std::vector<int> order_;  // object points in a fixed random order, for the preverification
+  std::vector<int> order_;                    // object points in a fixed random order, for the preverification
+  std::vector<std::vector<int>> neighbours_;  // per correspondence, when sampling is local (sample_radius_m)
 };
 
 }  // namespace
@@ -209,6 +256,7 @@ void RansacOptions::Check() const {
     if (!ok) ThrowInputError("RANSAC options", field, expected);
   };
   require(sample_size >= 3, "sample_size", "at least 3");
+  require(sample_radius_m >= 0.0, "sample_radius_m", ">= 0 m (0: sample anywhere)");
   require(std::isfinite(polygon_threshold) && polygon_threshold < 1.0, "polygon_threshold", "below 1 (<= 0 disables)");
   require(inlier_threshold_m > 0.0 && std::isfinite(inlier_threshold_m), "inlier_threshold_m", "> 0 m");
   require(required_inlier_fraction > 0.0 && required_inlier_fraction <= 1.0, "required_inlier_fraction", "in (0, 1]");

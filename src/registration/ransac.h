@@ -42,6 +42,11 @@ struct RansacOptions {
   /// whose true inlier fraction is at least the required one is dropped with a probability below 0.2 %
   /// per check. false: every point is checked, as in the paper.
   bool preverify = true;
+  /// Beyond the paper: the second and later correspondences of a sample are drawn among those whose scene
+  /// and object points both lie within this distance of the first one's, metres (0: anywhere, as in the
+  /// paper). Set to the object's diameter, a sample whose first correspondence is true is then all true with
+  /// probability w'^(n-1), w' the share of true ones near the object, instead of w^(n-1) over the whole scene.
+  double sample_radius_m = 0.0;
 
   /// Throws InputError on values outside their ranges.
   void Check() const;

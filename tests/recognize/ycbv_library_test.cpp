@@ -1,0 +1,106 @@
+// End to end on real data with the whole textured library: the 7 textured YCB meshes of ../shared/data
+// (6 google16k meshes moved into the YCB-Video object frame, and the YCB-Video banana) built with
+// `ecvpose modeldb build`, then `ecvpose recognize --sequence` over frame 000001 of videos 0000, 0001 and
+// 0002 (7 textured objects in all), scored against the ground truth.
+
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "io/frame_io.h"
+#include "io/mesh_io.h"
+#include "io/pose_io.h"
+#include "modeldb/model_library.h"
+#include "recognize/evaluation.h"
+#include "support/test_data.h"
+
+namespace ecv {
+namespace {
+
+constexpr int kFoundAtLeast = 3;  // of 7; see the test below
+
+class YcbvLibrary : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    directory_ = new test::TemporaryDirectory();
+    library_ = directory_->File("ycbv.sqlite");
+    const std::string data = test::DataPath("ycbv_subset");
+    for (const auto& [name, object_from_mesh] : ReadTransformTable(data + "/derived/google16k_to_ycbv.txt")) {
+      const std::string pose = directory_->File(name + ".json");
+      WriteJsonFile(pose, {{"object_from_mesh", PoseToJson(object_from_mesh)}});
+      const test::CommandResult build =
+          test::RunCli("modeldb build " + data + "/ycb_google16k_textured/" + name + "_textured.obj --name " + name +
+                       " --object-from-mesh " + pose + " --views 40 --distance 0.9 --db " + library_);
+      ASSERT_EQ(build.exit_code, 0) << build.output;
+    }
+    const test::CommandResult banana = test::RunCli("modeldb build " + data +
+                                                    "/models/011_banana/textured_simple.obj --name 011_banana "
+                                                    "--views 40 --distance 0.9 --db " +
+                                                    library_);
+    ASSERT_EQ(banana.exit_code, 0) << banana.output;
+  }
+  static void TearDownTestSuite() { delete directory_; }
+
+  static std::vector<std::string> Frames() {
+    const std::string scenes = test::DataPath("ycbv_subset/Example-Scenes/");
+    return {scenes + "0000/000001", scenes + "0001/000001", scenes + "0002/000001"};
+  }
+
+  // `recognize --sequence` over Frames(); the JSON lines, one per frame.
+  static std::vector<nlohmann::json> Recognize(const std::string& tag, const std::string& flags) {
+    const std::string list = directory_->File(tag + ".txt"), out = directory_->File(tag + ".jsonl");
+    std::ofstream(list) << Frames()[0] << '\n' << Frames()[1] << '\n' << Frames()[2] << '\n';
+    const test::CommandResult run =
+        test::RunCli("recognize --db " + library_ + " --sequence " + list + " --out-json " + out + " " + flags);
+    EXPECT_EQ(run.exit_code, 0) << run.output;
+    std::vector<nlohmann::json> lines;
+    std::ifstream in(out);
+    for (std::string line; std::getline(in, line);) lines.push_back(nlohmann::json::parse(line));
+    return lines;
+  }
+
+  static test::TemporaryDirectory* directory_;
+  static std::string library_;
+};
+
+test::TemporaryDirectory* YcbvLibrary::directory_ = nullptr;
+std::string YcbvLibrary::library_;
+
+TEST_F(YcbvLibrary, FindsTexturedObjectsOnThreeVideosWithoutFalsePositives) {
+  const std::vector<nlohmann::json> lines = Recognize("run", "");
+  ASSERT_EQ(lines.size(), 3U);
+  LibraryLoadOptions load;
+  load.build_matchers = false;
+  const ModelLibrary library = ModelLibrary::Load(library_, load);
+  ASSERT_EQ(library.models().size(), 7U);
+  std::vector<EvalModel> models;
+  for (const LibraryModel& model : library.models()) models.push_back(EvalModelFromRecord(model.record));
+
+  int present = 0, correct = 0, false_positives = 0;
+  std::string report;
+  for (size_t i = 0; i < lines.size(); ++i) {
+    const LoadedFrame frame = LoadYcbvFrame(Frames()[i]);
+    const FrameEvaluation evaluation =
+        EvaluateFrame(Frames()[i], DetectionsFromJson(lines[i], Frames()[i]), frame.ground_truth, models);
+    false_positives += evaluation.false_positives;
+    for (const ObjectEvaluation& object : evaluation.objects) {
+      ++present;
+      correct += object.correct ? 1 : 0;
+      report += Frames()[i] + " " + object.model + (object.correct ? " correct\n" : " missed\n");
+    }
+  }
+  EXPECT_EQ(present, 7);  // 009 in 0000; 003, 004, 006 in 0001; 006, 010, 011 in 0002
+  // Not yet the aim (all 7): the floor measured when this test was written, to catch regressions.
+  EXPECT_GE(correct, kFoundAtLeast) << report;
+  EXPECT_EQ(false_positives, 0) << report;
+}
+
+TEST_F(YcbvLibrary, SameSeedSameOutputWithOneOrTwoThreads) {
+  const std::vector<nlohmann::json> one = Recognize("one", "--threads 1 --seed 7");
+  const std::vector<nlohmann::json> two = Recognize("two", "--threads 2 --seed 7");
+  ASSERT_EQ(one.size(), two.size());
+  for (size_t i = 0; i < one.size(); ++i) EXPECT_EQ(one[i].at("detections"), two[i].at("detections")) << i;
+}
+
+}  // namespace
+}  // namespace ecv
