@@ -16,6 +16,7 @@
 #include "ecv/primitives.h"
 #include "io/mesh_io.h"
 #include "io/pose_io.h"
+#include "recognize/scoring.h"
 #include "render/overlay.h"
 #include "render/renderer.h"
 #include "render/view_sampling.h"
@@ -34,39 +35,7 @@ struct Scene {
   SceneVisibility visibility;
 };
 
-// The views of one model, or of all, in one index: each scene descriptor votes, through its nearest
-// descriptor there, for one view of one model.
-struct LibraryIndex {
-  std::vector<Primitive> primitives;   // every view's primitives, view after view, model after model
-  std::vector<int> model_of, view_of;  // the model and view of each
-  std::unique_ptr<DescriptorMatcher> matcher;
-};
-
-// An index over the views of records[first .. last).
-LibraryIndex BuildVoteIndex(const std::vector<ModelRecord>& records, size_t first, size_t last,
-                            const MatchOptions& options) {
-  LibraryIndex index;
-  Descriptors all;
-  std::vector<cv::Mat> rows;
-  for (size_t m = first; m < last; ++m) {
-    for (size_t v = 0; v < records[m].views.size(); ++v) {
-      const ModelView& view = records[m].views[v];
-      const int offset = static_cast<int>(index.primitives.size());
-      index.primitives.insert(index.primitives.end(), view.primitives.begin(), view.primitives.end());
-      index.model_of.insert(index.model_of.end(), view.primitives.size(), static_cast<int>(m));
-      index.view_of.insert(index.view_of.end(), view.primitives.size(), static_cast<int>(v));
-      if (view.descriptors.values.rows == 0) continue;
-      rows.push_back(view.descriptors.values);
-      for (const int primitive : view.descriptors.primitive) all.primitive.push_back(primitive + offset);
-    }
-  }
-  if (rows.empty()) return index;
-  cv::vconcat(rows, all.values);
-  index.matcher = std::make_unique<DescriptorMatcher>(index.primitives, all, options);
-  return index;
-}
-
-// A model view ranked by its votes or its consistent correspondences, with the correspondences for RANSAC.
+// A model view ranked by its consistent correspondences, with the correspondences for RANSAC.
 struct ViewCandidate {
   int view = -1;
   int score = 0;
@@ -90,104 +59,6 @@ Descriptors SampleRows(const Descriptors& descriptors, size_t count, uint64_t se
     subset.primitive.push_back(descriptors.primitive[static_cast<size_t>(order[i])]);
   }
   return subset;
-}
-
-// Whether two correspondences can both be true: their object and scene primitives lie equally far apart
-// (within `tolerance_m`, and at least 2 cm so the distance says something; at most `max_distance_m`), and
-// the |cosines| between their orientations and the line joining them agree within `angle_tolerance`.
-bool Consistent(const Primitive& object_a, const Primitive& scene_a, const Primitive& object_b,
-                const Primitive& scene_b, float max_distance_m, float tolerance_m, float angle_tolerance) {
-  constexpr float kMinDistance = 0.02F;
-  Eigen::Vector3f object_line = object_b.position - object_a.position;
-  Eigen::Vector3f scene_line = scene_b.position - scene_a.position;
-  const float object_distance = object_line.norm(), scene_distance = scene_line.norm();
-  if (object_distance < kMinDistance || object_distance > max_distance_m ||
-      std::abs(object_distance - scene_distance) > tolerance_m) {
-    return false;
-  }
-  object_line /= object_distance;
-  scene_line /= scene_distance;
-  auto agree = [&](const Eigen::Vector3f& a, const Eigen::Vector3f& b, const Eigen::Vector3f& c,
-                   const Eigen::Vector3f& d) {
-    return std::abs(std::abs(a.dot(b)) - std::abs(c.dot(d))) <= angle_tolerance;
-  };
-  return agree(object_a.orientation, object_b.orientation, scene_a.orientation, scene_b.orientation) &&
-         agree(object_a.orientation, object_line, scene_a.orientation, scene_line) &&
-         agree(object_b.orientation, object_line, scene_b.orientation, scene_line);
-}
-
-// The size of a large set of pairwise-consistent correspondences, grown greedily from each one in turn
-// (its consistent partners taken by how many of the others they agree with).
-int ConsistentSetSize(const std::vector<Primitive>& object, const std::vector<Primitive>& scene,
-                      const std::vector<Correspondence>& correspondences, float max_distance_m, float tolerance_m,
-                      float angle_tolerance) {
-  const size_t n = correspondences.size();
-  std::vector<std::vector<int>> partners(n);
-  std::vector<char> agree(n * n, 0);
-  for (size_t a = 0; a < n; ++a) {
-    const Primitive& object_a = object[static_cast<size_t>(correspondences[a].object)];
-    const Primitive& scene_a = scene[static_cast<size_t>(correspondences[a].scene)];
-    for (size_t b = a + 1; b < n; ++b) {
-      if (!Consistent(object_a, scene_a, object[static_cast<size_t>(correspondences[b].object)],
-                      scene[static_cast<size_t>(correspondences[b].scene)], max_distance_m, tolerance_m,
-                      angle_tolerance)) {
-        continue;
-      }
-      agree[a * n + b] = agree[b * n + a] = 1;
-      partners[a].push_back(static_cast<int>(b));
-      partners[b].push_back(static_cast<int>(a));
-    }
-  }
-  int best = n > 0 ? 1 : 0;
-  for (size_t a = 0; a < n; ++a) {
-    if (static_cast<int>(partners[a].size()) < best) continue;  // cannot grow a larger set
-    std::vector<int>& candidates = partners[a];
-    std::vector<int> degree(candidates.size(), 0);
-    for (size_t x = 0; x < candidates.size(); ++x) {
-      for (const int y : candidates)
-        degree[x] += agree[static_cast<size_t>(candidates[x]) * n + static_cast<size_t>(y)];
-    }
-    std::vector<size_t> order(candidates.size());
-    std::iota(order.begin(), order.end(), 0);
-    std::stable_sort(order.begin(), order.end(), [&](size_t x, size_t y) { return degree[x] > degree[y]; });
-    std::vector<int> set;
-    for (const size_t x : order) {
-      const int candidate = candidates[x];
-      if (std::all_of(set.begin(), set.end(), [&](int member) {
-            return agree[static_cast<size_t>(member) * n + static_cast<size_t>(candidate)] != 0;
-          })) {
-        set.push_back(candidate);
-      }
-    }
-    best = std::max(best, static_cast<int>(set.size()) + 1);
-  }
-  return best;
-}
-
-// Normalised cross-correlation of (model, scene) colour pairs, per channel, averaged and clipped to [0, 1]:
-// high when the model's texture lies where the scene shows it, whatever the gain and offset of the light.
-double ColorCorrelation(const std::vector<std::pair<Eigen::Vector3f, Eigen::Vector3f>>& colors) {
-  constexpr size_t kMinPixels = 10;
-  if (colors.size() < kMinPixels) return 0.0;
-  Eigen::Vector3f model_mean = Eigen::Vector3f::Zero(), scene_mean = Eigen::Vector3f::Zero();
-  for (const auto& [model, scene] : colors) {
-    model_mean += model;
-    scene_mean += scene;
-  }
-  model_mean /= static_cast<float>(colors.size());
-  scene_mean /= static_cast<float>(colors.size());
-  Eigen::Vector3f cross = Eigen::Vector3f::Zero(), model_variance = cross, scene_variance = cross;
-  for (const auto& [model, scene] : colors) {
-    const Eigen::Vector3f a = model - model_mean, b = scene - scene_mean;
-    cross += a.cwiseProduct(b);
-    model_variance += a.cwiseProduct(a);
-    scene_variance += b.cwiseProduct(b);
-  }
-  double correlation = 0.0;
-  for (int k = 0; k < 3; ++k) {
-    correlation += cross[k] / std::sqrt(std::max(1e-9F, model_variance[k] * scene_variance[k])) / 3.0;
-  }
-  return std::max(0.0, correlation);
 }
 
 // A pose hypothesis of a model from one of its views.
@@ -220,9 +91,7 @@ void RecognizerOptions::Check() const {
     if (!ok) ThrowInputError("recognizer options", field, expected);
   };
   require(views_per_model >= 1, "views_per_model", "at least 1");
-  require(ratio_test > 0.0 && ratio_test <= 1.0, "ratio_test", "in (0, 1]");
-  require(consistency_tolerance_m > 0.0, "consistency_tolerance_m", "> 0 m");
-  require(consistency_angle_tolerance > 0.0, "consistency_angle_tolerance", "> 0");
+  consistency.Check();
   require(consistency_max_correspondences >= 3, "consistency_max_correspondences", "at least 3");
   require(dense_stride_px >= 1, "dense_stride_px", "at least 1");
   require(sample_radius_diameters >= 0.0, "sample_radius_diameters", ">= 0 (0: sample anywhere)");
@@ -238,8 +107,7 @@ class Recognizer::Impl {
  public:
   Impl(const ModelLibrary& library, const RecognizerOptions& options) : library_(library), options_(options) {
     options_.Check();
-    const bool votes = options_.view_ranking == RecognizerOptions::ViewRanking::kVotes;
-    options_.match.k = votes ? 2 : 1;  // votes need the second nearest for their ratio test
+    options_.match.k = 1;
     for (const LibraryModel& model : library_.models()) {
       // With a colour matrix, the views' colours are mapped into the scene camera's colours and their
       // descriptors recomputed (paper Sect. IV-C: A c_model = c_scene before matching).
@@ -257,13 +125,6 @@ class Recognizer::Impl {
       load.allow_missing_textures = true;
       meshes_.push_back(renderer_.AddMesh(LoadMesh(record.mesh_path, load)));
     }
-    if (!votes) return;
-    if (options_.library_wide_votes) {
-      vote_indices_.push_back(BuildVoteIndex(records_, 0, records_.size(), options_.match));
-    } else {
-      for (size_t m = 0; m < records_.size(); ++m)
-        vote_indices_.push_back(BuildVoteIndex(records_, m, m + 1, options_.match));
-    }
   }
 
   RecognitionResult Recognize(const RgbdFrame& frame) {
@@ -271,13 +132,11 @@ class Recognizer::Impl {
     const Clock::time_point start = Clock::now();
     RecognitionResult result;
     const Scene scene = PrepareScene(frame, &result);
-    Clock::time_point stage = Clock::now();
-    const std::vector<std::vector<int>> votes = CountVotes(scene);
-    result.timings_ms["match"] += MillisecondsSince(stage);
+    Clock::time_point stage;
     std::vector<std::pair<size_t, Detection>> candidates;  // (model, its best detection)
     for (size_t m = 0; m < library_.models().size(); ++m) {
       stage = Clock::now();
-      const std::vector<ViewCandidate> views = RankViews(m, votes[m], scene);
+      const std::vector<ViewCandidate> views = RankViews(m, scene);
       result.timings_ms["match"] += MillisecondsSince(stage);
 
       stage = Clock::now();
@@ -356,50 +215,24 @@ class Recognizer::Impl {
     return scene;
   }
 
-  // Votes per model and view: scene descriptors whose nearest library descriptor lies in the view and
-  // passes the ratio test against the second nearest.
-  std::vector<std::vector<int>> CountVotes(const Scene& scene) const {
-    std::vector<std::vector<int>> votes;
-    for (const ModelRecord& record : records_) votes.emplace_back(record.views.size(), 0);
-    if (!scene.matcher) return votes;
-    for (const LibraryIndex& index : vote_indices_) {
-      if (!index.matcher) continue;
-      const std::vector<DescriptorMatch> matches = index.matcher->Match(scene.primitives, scene.descriptors);
-      for (size_t i = 0; i + 1 < matches.size(); ++i) {
-        const DescriptorMatch& nearest = matches[i];
-        const DescriptorMatch& second = matches[i + 1];
-        if (nearest.rank != 0 || second.rank != 1 || second.query != nearest.query) continue;
-        if (nearest.distance < options_.ratio_test * second.distance) {
-          const size_t train = static_cast<size_t>(nearest.train);
-          ++votes[static_cast<size_t>(index.model_of[train])][static_cast<size_t>(index.view_of[train])];
-        }
-      }
-    }
-    return votes;
-  }
-
   // The model's best-ranked views, each with its correspondences: the nearest scene descriptor of each of
   // its descriptors (paper: object to scene).
-  std::vector<ViewCandidate> RankViews(size_t model, const std::vector<int>& votes, const Scene& scene) const {
+  std::vector<ViewCandidate> RankViews(size_t model, const Scene& scene) const {
     std::vector<ViewCandidate> views;
     if (!scene.matcher) return views;
     const ModelRecord& record = records_[model];
-    const bool by_votes = options_.view_ranking == RecognizerOptions::ViewRanking::kVotes;
     for (size_t v = 0; v < record.views.size(); ++v) {
       const ModelView& view = record.views[v];
       if (view.descriptors.values.rows == 0) continue;
       ViewCandidate candidate;
       candidate.view = static_cast<int>(v);
-      if (by_votes) {
-        candidate.score = votes[v];
-      } else {  // scored on a seeded subset of the view's descriptors, for speed
-        const Descriptors subset = SampleRows(
-            view.descriptors, static_cast<size_t>(options_.consistency_max_correspondences), options_.ransac.seed + v);
-        candidate.score = ConsistentSetSize(view.primitives, scene.primitives, Correspondences(view, subset, scene),
-                                            static_cast<float>(record.diameter_m),
-                                            static_cast<float>(options_.consistency_tolerance_m),
-                                            static_cast<float>(options_.consistency_angle_tolerance));
-      }
+      // Scored on a seeded subset of the view's descriptors, for speed.
+      const Descriptors subset = SampleRows(
+          view.descriptors, static_cast<size_t>(options_.consistency_max_correspondences), options_.ransac.seed + v);
+      ConsistencyOptions consistency = options_.consistency;
+      consistency.max_distance_m = record.diameter_m;
+      candidate.score =
+          ConsistentSetSize(view.primitives, scene.primitives, Correspondences(view, subset, scene), consistency);
       views.push_back(std::move(candidate));
     }
     std::stable_sort(views.begin(), views.end(),
@@ -583,7 +416,6 @@ class Recognizer::Impl {
   std::vector<ModelRecord> records_;  // per model: the library's, colours mapped by its colour matrix if any
   Renderer renderer_;
   std::vector<MeshId> meshes_;
-  std::vector<LibraryIndex> vote_indices_;  // one per model, or one for all (library_wide_votes)
 };
 
 Recognizer::Recognizer(const ModelLibrary& library, const RecognizerOptions& options)

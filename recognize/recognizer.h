@@ -12,6 +12,7 @@
 #include "core/frame.h"
 #include "ecv/matching.h"
 #include "modeldb/model_library.h"
+#include "recognize/scoring.h"
 #include "registration/icp.h"
 #include "registration/ransac.h"
 
@@ -27,26 +28,13 @@ struct RecognizerOptions {
   /// The scene's descriptors take at most this many neighbours (spread over the distance ranks, see
   /// DescriptorOptions::max_neighbours) when the library's setting allows more; 0 keeps the library's.
   int scene_max_neighbours = 0;
-  /// How a model's views are ranked before RANSAC.
-  enum class ViewRanking {
-    /// Each view's object-to-scene correspondences (nearest scene descriptor of each view descriptor) are
-    /// scored by their largest pairwise-consistent set: correspondences that agree on the distances and
-    /// angles between their primitives. True ones agree with one another; false ones rarely do.
-    kConsistency,
-    /// Each scene descriptor votes, through its nearest descriptor over the model's views and a ratio test,
-    /// for one view. Near-duplicates of a surface spot in neighbouring views fail the ratio test, so on
-    /// YCB-Video the votes rarely pick the right view.
-    kVotes,
-  };
-  ViewRanking view_ranking = ViewRanking::kConsistency;
-  double consistency_tolerance_m = 0.01;     ///< two correspondences agree when their distances differ by less
-  double consistency_angle_tolerance = 0.2;  ///< ... and the |cosines| between their orientations by less
+  /// A model's views are ranked by the largest pairwise-consistent set among their object-to-scene
+  /// correspondences (ConsistentSetSize; max_distance_m is set to each model's diameter). On YCB-Video this
+  /// replaced votes of the scene descriptors for views through a ratio test, which rarely picked the right
+  /// view: near-duplicates of a surface spot in neighbouring views fail the ratio test.
+  ConsistencyOptions consistency;
   /// Per view, at most this many of its descriptors (a seeded random subset) are matched for the ranking.
   int consistency_max_correspondences = 200;
-  double ratio_test = 0.9;  ///< kVotes: a match votes for its view when nearest / second-nearest is below
-  /// kVotes with one index over all models' views instead of one per model. On the 30 YCB-Video frames with
-  /// 6 models it found 15 of 60 objects against 24 of 60 per model.
-  bool library_wide_votes = false;
   /// Beyond the paper: a RANSAC sample's later correspondences are drawn near its first one, within this
   /// many model diameters (RansacOptions::sample_radius_m); 0 draws them anywhere in the scene.
   double sample_radius_diameters = 1.0;

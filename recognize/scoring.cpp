@@ -1,0 +1,118 @@
+#include "recognize/scoring.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "core/error.h"
+
+namespace ecv {
+namespace {
+
+// Whether two correspondences can both be true (ConsistencyOptions).
+bool Consistent(const Primitive& object_a, const Primitive& scene_a, const Primitive& object_b,
+                const Primitive& scene_b, const ConsistencyOptions& options) {
+  const auto tolerance_m = static_cast<float>(options.tolerance_m);
+  const auto angle_tolerance = static_cast<float>(options.angle_tolerance);
+  Eigen::Vector3f object_line = object_b.position - object_a.position;
+  Eigen::Vector3f scene_line = scene_b.position - scene_a.position;
+  const float object_distance = object_line.norm(), scene_distance = scene_line.norm();
+  if (object_distance < static_cast<float>(options.min_distance_m) ||
+      object_distance > static_cast<float>(options.max_distance_m) ||
+      std::abs(object_distance - scene_distance) > tolerance_m) {
+    return false;
+  }
+  object_line /= object_distance;
+  scene_line /= scene_distance;
+  auto agree = [&](const Eigen::Vector3f& a, const Eigen::Vector3f& b, const Eigen::Vector3f& c,
+                   const Eigen::Vector3f& d) {
+    return std::abs(std::abs(a.dot(b)) - std::abs(c.dot(d))) <= angle_tolerance;
+  };
+  return agree(object_a.orientation, object_b.orientation, scene_a.orientation, scene_b.orientation) &&
+         agree(object_a.orientation, object_line, scene_a.orientation, scene_line) &&
+         agree(object_b.orientation, object_line, scene_b.orientation, scene_line);
+}
+
+}  // namespace
+
+void ConsistencyOptions::Check() const {
+  auto require = [](bool ok, const char* field, const char* expected) {
+    if (!ok) ThrowInputError("consistency options", field, expected);
+  };
+  require(tolerance_m > 0.0, "tolerance_m", "> 0 m");
+  require(angle_tolerance > 0.0, "angle_tolerance", "> 0");
+  require(min_distance_m >= 0.0 && max_distance_m > min_distance_m, "max_distance_m", "> min_distance_m >= 0 m");
+}
+
+int ConsistentSetSize(const std::vector<Primitive>& object, const std::vector<Primitive>& scene,
+                      const std::vector<Correspondence>& correspondences, const ConsistencyOptions& options) {
+  options.Check();
+  const size_t n = correspondences.size();
+  std::vector<std::vector<int>> partners(n);
+  std::vector<char> agree(n * n, 0);
+  for (size_t a = 0; a < n; ++a) {
+    const Primitive& object_a = object[static_cast<size_t>(correspondences[a].object)];
+    const Primitive& scene_a = scene[static_cast<size_t>(correspondences[a].scene)];
+    for (size_t b = a + 1; b < n; ++b) {
+      if (!Consistent(object_a, scene_a, object[static_cast<size_t>(correspondences[b].object)],
+                      scene[static_cast<size_t>(correspondences[b].scene)], options)) {
+        continue;
+      }
+      agree[a * n + b] = agree[b * n + a] = 1;
+      partners[a].push_back(static_cast<int>(b));
+      partners[b].push_back(static_cast<int>(a));
+    }
+  }
+  int best = n > 0 ? 1 : 0;
+  for (size_t a = 0; a < n; ++a) {
+    if (static_cast<int>(partners[a].size()) < best) continue;  // cannot grow a larger set
+    std::vector<int>& candidates = partners[a];
+    std::vector<int> degree(candidates.size(), 0);
+    for (size_t x = 0; x < candidates.size(); ++x) {
+      for (const int y : candidates)
+        degree[x] += agree[static_cast<size_t>(candidates[x]) * n + static_cast<size_t>(y)];
+    }
+    std::vector<size_t> order(candidates.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(), [&](size_t x, size_t y) { return degree[x] > degree[y]; });
+    std::vector<int> set;
+    for (const size_t x : order) {
+      const int candidate = candidates[x];
+      if (std::all_of(set.begin(), set.end(), [&](int member) {
+            return agree[static_cast<size_t>(member) * n + static_cast<size_t>(candidate)] != 0;
+          })) {
+        set.push_back(candidate);
+      }
+    }
+    best = std::max(best, static_cast<int>(set.size()) + 1);
+  }
+  return best;
+}
+
+// Normalised cross-correlation of (model, scene) colour pairs, per channel, averaged and clipped to [0, 1]:
+// high when the model's texture lies where the scene shows it, whatever the gain and offset of the light.
+double ColorCorrelation(const std::vector<std::pair<Eigen::Vector3f, Eigen::Vector3f>>& colors) {
+  constexpr size_t kMinPixels = 10;
+  if (colors.size() < kMinPixels) return 0.0;
+  Eigen::Vector3f model_mean = Eigen::Vector3f::Zero(), scene_mean = Eigen::Vector3f::Zero();
+  for (const auto& [model, scene] : colors) {
+    model_mean += model;
+    scene_mean += scene;
+  }
+  model_mean /= static_cast<float>(colors.size());
+  scene_mean /= static_cast<float>(colors.size());
+  Eigen::Vector3f cross = Eigen::Vector3f::Zero(), model_variance = cross, scene_variance = cross;
+  for (const auto& [model, scene] : colors) {
+    const Eigen::Vector3f a = model - model_mean, b = scene - scene_mean;
+    cross += a.cwiseProduct(b);
+    model_variance += a.cwiseProduct(a);
+    scene_variance += b.cwiseProduct(b);
+  }
+  double correlation = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    correlation += cross[k] / std::sqrt(std::max(1e-9F, model_variance[k] * scene_variance[k])) / 3.0;
+  }
+  return std::max(0.0, correlation);
+}
+
+}  // namespace ecv

@@ -1,0 +1,131 @@
+// The recognizer's scores on constructed data: the consistent-set size of planted true correspondences
+// among false ones, and the colour correlation's invariance to gain and offset.
+
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "core/error.h"
+#include "recognize/scoring.h"
+
+namespace ecv {
+namespace {
+
+Primitive RandomPrimitive(std::mt19937& random, float extent) {
+  std::uniform_real_distribution<float> coordinate(0.0F, extent);
+  std::normal_distribution<float> normal(0.0F, 1.0F);
+  Primitive primitive;
+  primitive.position = {coordinate(random), coordinate(random), coordinate(random)};
+  primitive.orientation = Eigen::Vector3f(normal(random), normal(random), normal(random)).normalized();
+  return primitive;
+}
+
+// `true_count` object primitives seen in the scene under a rigid motion (2 mm noise), then `false_count`
+// correspondences to random scene primitives in a 1 m cube; correspondence i pairs object i with scene i.
+struct Planted {
+  std::vector<Primitive> object, scene;
+  std::vector<Correspondence> correspondences;
+};
+
+Planted Plant(int true_count, int false_count, unsigned seed) {
+  std::mt19937 random(seed);
+  std::normal_distribution<float> noise(0.0F, 0.002F);
+  const Eigen::Isometry3f motion = Eigen::Translation3f(0.1F, -0.2F, 0.7F) *
+                                   Eigen::AngleAxisf(1.1F, Eigen::Vector3f(1.0F, 2.0F, -0.5F).normalized());
+  Planted planted;
+  for (int i = 0; i < true_count + false_count; ++i) {
+    planted.object.push_back(RandomPrimitive(random, 0.2F));
+    Primitive seen = i < true_count ? planted.object.back() : RandomPrimitive(random, 1.0F);
+    if (i < true_count) {
+      seen.position = motion * seen.position + Eigen::Vector3f(noise(random), noise(random), noise(random));
+      seen.orientation = motion.linear() * seen.orientation;
+    }
+    planted.scene.push_back(seen);
+    planted.correspondences.push_back({i, i});
+  }
+  return planted;
+}
+
+TEST(ConsistentSetSize, FindsPlantedTrueCorrespondencesAmongManyFalseOnes) {
+  ConsistencyOptions options;
+  options.max_distance_m = 0.35;  // the object's diameter
+  for (unsigned seed = 1; seed <= 5; ++seed) {
+    const Planted planted = Plant(25, 300, seed);
+    const int size = ConsistentSetSize(planted.object, planted.scene, planted.correspondences, options);
+    EXPECT_GE(size, 22) << "seed " << seed;
+    EXPECT_LE(size, 28) << "seed " << seed;
+  }
+}
+
+TEST(ConsistentSetSize, StaysSmallWithoutTrueCorrespondences) {
+  ConsistencyOptions options;
+  options.max_distance_m = 0.35;
+  for (unsigned seed = 1; seed <= 5; ++seed) {
+    const Planted planted = Plant(0, 325, seed);
+    EXPECT_LE(ConsistentSetSize(planted.object, planted.scene, planted.correspondences, options), 8) << seed;
+  }
+}
+
+TEST(ConsistentSetSize, CountsEveryExactCorrespondenceAtTightTolerances) {
+  // A 4 x 5 grid 4 cm apart (every pair beyond the 2 cm minimum), moved without noise: all 20 agree.
+  std::mt19937 random(3);
+  const Eigen::Isometry3f motion =
+      Eigen::Translation3f(0.3F, 0.1F, 0.9F) * Eigen::AngleAxisf(2.0F, Eigen::Vector3f::UnitY());
+  std::vector<Primitive> object, scene;
+  std::vector<Correspondence> correspondences;
+  for (int i = 0; i < 20; ++i) {
+    Primitive primitive = RandomPrimitive(random, 0.1F);
+    primitive.position = {0.04F * static_cast<float>(i % 4), 0.04F * static_cast<float>(i / 4), 0.0F};
+    object.push_back(primitive);
+    primitive.position = motion * primitive.position;
+    primitive.orientation = motion.linear() * primitive.orientation;
+    scene.push_back(primitive);
+    correspondences.push_back({i, i});
+  }
+  ConsistencyOptions options;
+  options.tolerance_m = 0.001;
+  options.angle_tolerance = 0.01;
+  EXPECT_EQ(ConsistentSetSize(object, scene, correspondences, options), 20);
+  scene[7].orientation = -scene[7].orientation;  // a direction's sign carries no meaning
+  EXPECT_EQ(ConsistentSetSize(object, scene, correspondences, options), 20);
+  scene[7].position.x() += 0.01F;  // now 1 cm off: it disagrees with the others
+  EXPECT_EQ(ConsistentSetSize(object, scene, correspondences, options), 19);
+}
+
+TEST(ConsistentSetSize, RejectsBadOptions) {
+  ConsistencyOptions options;
+  options.tolerance_m = 0.0;
+  const Planted planted = Plant(5, 0, 1);
+  EXPECT_THROW(ConsistentSetSize(planted.object, planted.scene, planted.correspondences, options), InputError);
+}
+
+std::vector<std::pair<Eigen::Vector3f, Eigen::Vector3f>> Colors(int count, unsigned seed) {
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<float> value(0.0F, 1.0F);
+  std::vector<std::pair<Eigen::Vector3f, Eigen::Vector3f>> colors;
+  for (int i = 0; i < count; ++i) {
+    const Eigen::Vector3f model(value(random), value(random), value(random));
+    colors.emplace_back(model, model);
+  }
+  return colors;
+}
+
+TEST(ColorCorrelation, IgnoresGainAndOffsetPerChannel) {
+  auto colors = Colors(500, 1);
+  for (auto& [model, scene] : colors) scene = Eigen::Vector3f(0.6F, 0.9F, 0.3F).cwiseProduct(model).array() + 0.1F;
+  EXPECT_GT(ColorCorrelation(colors), 0.999);
+}
+
+TEST(ColorCorrelation, IsNearZeroForUnrelatedColoursAndZeroWhenInverted) {
+  auto unrelated = Colors(2000, 2);
+  const auto others = Colors(2000, 3);
+  for (size_t i = 0; i < unrelated.size(); ++i) unrelated[i].second = others[i].first;
+  EXPECT_LT(ColorCorrelation(unrelated), 0.1);
+  auto inverted = Colors(500, 4);
+  for (auto& [model, scene] : inverted) scene = Eigen::Vector3f::Ones() - model;
+  EXPECT_EQ(ColorCorrelation(inverted), 0.0);
+  EXPECT_EQ(ColorCorrelation(Colors(9, 5)), 0.0);  // too few pairs to say
+}
+
+}  // namespace
+}  // namespace ecv
