@@ -1,11 +1,13 @@
 // `ecvpose recognize --db lib.sqlite FRAME`: finds the library's objects in an RGB-D frame.
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <memory>
 #include <sstream>
+#include <thread>
 
 #include "app/commands.h"
 #include "app/frame_args.h"
@@ -190,12 +192,15 @@ CommandAction SetupRecognizeCommand(CLI::App& command) {
   command.add_option("--image-id", args->image_id, "BOP image id (default: from the frame name)");
   command.add_option("--overlay", args->overlay, "Picture: each detected model in red with its name (PNG)");
   RecognizerOptions& options = args->options;
+  options.ransac.threads = static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
   command.add_option("--views-per-model", options.views_per_model, "Library views tried with RANSAC per model")
       ->capture_default_str();
   command.add_option("--min-score", options.min_score, "Detections below this score are dropped")
       ->capture_default_str();
   command.add_option("--seed", options.ransac.seed, "Random seed")->capture_default_str();
-  command.add_option("--threads", options.ransac.threads, "RANSAC threads (same result for any count)")
+  command
+      .add_option("--threads", options.ransac.threads,
+                  "Worker threads for view ranking and RANSAC (same result for any count)")
       ->capture_default_str();
   command.add_flag(
       "--no-icp", [&options = args->options](int64_t) { options.refine = false; }, "Skip the ICP refinement");

@@ -1,11 +1,13 @@
 #include "recognize/recognizer.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <numeric>
 #include <random>
+#include <thread>
 
 #include <opencv2/imgproc.hpp>
 
@@ -134,13 +136,12 @@ class Recognizer::Impl {
     const Scene scene = PrepareScene(frame, &result);
     Clock::time_point stage;
     std::vector<std::pair<size_t, Detection>> candidates;  // (model, its best detection)
+    stage = Clock::now();
+    const std::vector<std::vector<ViewCandidate>> ranked = RankAllViews(scene);
+    result.timings_ms["match"] += MillisecondsSince(stage);
     for (size_t m = 0; m < library_.models().size(); ++m) {
       stage = Clock::now();
-      const std::vector<ViewCandidate> views = RankViews(m, scene);
-      result.timings_ms["match"] += MillisecondsSince(stage);
-
-      stage = Clock::now();
-      std::vector<Hypothesis> hypotheses = EstimatePoses(records_[m], views, scene);
+      std::vector<Hypothesis> hypotheses = EstimatePoses(records_[m], ranked[m], scene);
       result.timings_ms["ransac"] += MillisecondsSince(stage);
 
       // Every hypothesis is verified as it is; the best one is refined and verified again.
@@ -213,6 +214,22 @@ class Recognizer::Impl {
     scene.visibility.depth = frame.depth;
     scene.visibility.camera = frame.camera;
     return scene;
+  }
+
+  // RankViews of every model, the models shared out over RansacOptions::threads workers (each model's
+  // ranking depends on nothing else, so the result does not depend on the count).
+  std::vector<std::vector<ViewCandidate>> RankAllViews(const Scene& scene) const {
+    std::vector<std::vector<ViewCandidate>> ranked(records_.size());
+    std::atomic<size_t> next{0};
+    auto work = [&] {
+      for (size_t m = next++; m < records_.size(); m = next++) ranked[m] = RankViews(m, scene);
+    };
+    std::vector<std::thread> workers;
+    const size_t threads = std::min(records_.size(), static_cast<size_t>(options_.ransac.threads));
+    for (size_t t = 1; t < threads; ++t) workers.emplace_back(work);
+    work();
+    for (std::thread& worker : workers) worker.join();
+    return ranked;
   }
 
   // The model's best-ranked views, each with its correspondences: the nearest scene descriptor of each of
