@@ -171,7 +171,8 @@ TEST_F(EvalCli, BopCsvOnLmoSceneJudgesTheTurnedDrillerWrong) {
 }
 
 // recognize --sequence over a BOP scene (a copy of LM-O scene 2 with the depth of image 3) writes JSON Lines and a
-// BOP CSV; eval --gt-bop judges both alike, whatever the recognizer found.
+// BOP CSV; eval --gt-bop judges both alike. --min-score 0 keeps every model's best pose, so the CSV has rows
+// (a CSV cannot tell a frame with no detection from a frame left out).
 TEST_F(EvalCli, RecognizeSequenceOnBopSceneJudgedAlikeFromJsonLinesAndCsv) {
   const fs::path source = test::DataPath("lmo_subset/data/bop/lmo/test/000002");
   const fs::path scene = directory_->path() / "bop" / "000002";
@@ -184,7 +185,7 @@ TEST_F(EvalCli, RecognizeSequenceOnBopSceneJudgedAlikeFromJsonLinesAndCsv) {
                 fs::copy_options::overwrite_existing);
   const std::string lines = directory_->File("bop.jsonl"), csv = directory_->File("bop.csv");
   const test::CommandResult run = test::RunCli("recognize --db " + lmo_library_ + " --sequence " + scene.string() +
-                                               " --out-json " + lines + " --out-bop " + csv);
+                                               " --out-json " + lines + " --out-bop " + csv + " --min-score 0");
   ASSERT_EQ(run.exit_code, 0) << run.output;
   std::ifstream in(lines);
   std::string first;
