@@ -31,7 +31,13 @@ struct ColorcalArgs {
   // fit
   std::string pairs_path;
   std::string method = "ransac";
+  // The matrices the recognizer applies before matching: per-channel gains, brightness kept. Measured by
+  // recognize_bench on YCB-Video (bench/RESULTS.md, "Colour calibration: hand pairs and the effect on matching"):
+  // 30 of 70 objects against 25 without matrices and 21-23 with full or auto-form matrices as fitted.
+  std::string form = "diagonal";
+  bool keep_brightness = true;
   // auto
+  std::vector<std::string> frames;  // positional FRAMEs; empty: the frame given by --color/--depth
   FrameSpec frame;
   std::string pose_path;
   double max_depth_difference_m = 0.01;
@@ -49,6 +55,17 @@ ColorFitMethod MethodArgument(const std::string& method) {
   return ColorFitMethod::kRansac;
 }
 
+ColorFitOptions FitOptions(const ColorcalArgs& args) {
+  ColorFitOptions options;
+  options.method = MethodArgument(args.method);
+  if (args.form == "full") options.form = ColorMatrixForm::kFull;
+  if (args.form == "diagonal") options.form = ColorMatrixForm::kDiagonal;
+  if (args.form == "auto") options.form = ColorMatrixForm::kAuto;
+  options.keep_brightness = args.keep_brightness;
+  options.Check();
+  return options;
+}
+
 void PrintMatrix(const Eigen::Matrix3d& a) {
   for (int row = 0; row < 3; ++row) {
     std::cout << (row == 0 ? "A = [" : "     ");
@@ -58,11 +75,13 @@ void PrintMatrix(const Eigen::Matrix3d& a) {
 }
 
 void PrintFit(const ColorFit& fit, size_t num_pairs, ColorFitMethod method) {
-  std::cout << "method: " << ToString(method) << '\n';
+  std::cout << "method: " << ToString(method) << ", form: " << ToString(fit.form) << '\n';
   PrintMatrix(fit.A);
   std::cout << "rms: " << Fixed(fit.rms, 6) << " (RGB in [0, 1])\n"
             << "condition number: " << Fixed(fit.condition_number, 2) << '\n'
             << "inliers: " << fit.num_inliers << "/" << num_pairs << '\n';
+  if (fit.brightness_scale != 1.0)
+    std::cout << "brightness kept: A scaled by " << Fixed(fit.brightness_scale, 4) << '\n';
 }
 
 // The model's summary; throws InputError naming the model and the library when there is none.
@@ -88,9 +107,7 @@ int RunFit(const ColorcalArgs& args) {
   ModelDatabase database(args.db, OpenMode::kReadWrite);
   FindModelOrThrow(database, args.model);  // before reading the pairs: a wrong name fails at once
   const std::vector<ColorPair> pairs = ReadColorPairsCsv(args.pairs_path);
-  ColorFitOptions options;
-  options.method = MethodArgument(args.method);
-  options.Check();
+  const ColorFitOptions options = FitOptions(args);
   const ColorFit fit = FitColorMatrix(pairs, options);
   std::cout << args.model << ": " << pairs.size() << " pairs from " << args.pairs_path << '\n';
   PrintFit(fit, pairs.size(), options.method);
@@ -107,40 +124,21 @@ std::string FrameName(const FrameSpec& spec) {
   return parent.empty() ? path.filename().string() : parent + "/" + path.filename().string();
 }
 
-int RunAuto(const ColorcalArgs& args) {
-  ModelDatabase database(args.db, OpenMode::kReadWrite);
-  const ModelSummary model = FindModelOrThrow(database, args.model);
-  const LoadedFrame frame = LoadFrame(args.frame);
-  const std::string frame_name = FrameName(args.frame);
-
-  Eigen::Isometry3d camera_from_object = Eigen::Isometry3d::Identity();
-  if (!args.pose_path.empty()) {
-    camera_from_object = ReadPoseFile(args.pose_path, "camera_from_object");
-  } else {
-    bool found = false;
-    for (const GroundTruth& truth : frame.ground_truth) {
-      if (truth.object_name != args.model) continue;
-      camera_from_object = truth.camera_from_object;
-      found = true;
-      break;
-    }
-    if (!found) {
-      throw InputError("no pose of \"" + args.model + "\" in frame " + frame_name +
-                       ": give --pose FILE (key camera_from_object), or a frame whose ground truth holds " +
-                       args.model);
-    }
+// The model's pose in the frame: --pose FILE, else the frame's ground truth of the model.
+Eigen::Isometry3d PoseInFrame(const ColorcalArgs& args, const LoadedFrame& frame, const std::string& frame_name) {
+  if (!args.pose_path.empty()) return ReadPoseFile(args.pose_path, "camera_from_object");
+  for (const GroundTruth& truth : frame.ground_truth) {
+    if (truth.object_name == args.model) return truth.camera_from_object;
   }
+  throw InputError("no pose of \"" + args.model + "\" in frame " + frame_name +
+                   ": give --pose FILE (key camera_from_object), or a frame whose ground truth holds " + args.model);
+}
 
-  MeshLoadOptions mesh_options;
-  mesh_options.metres_per_unit = MetresPerUnit(model.unit);
-  mesh_options.object_from_mesh = model.object_from_mesh;
-  mesh_options.allow_missing_textures = true;
-  std::vector<std::string> warnings;
-  const TriangleMesh mesh = LoadMesh(model.mesh_path, mesh_options, &warnings);
-  for (const std::string& warning : warnings) std::cerr << "ecvpose: warning: " << warning << '\n';
-
-  Renderer renderer;
-  const MeshId id = renderer.AddMesh(mesh);
+// Automatic pairs of the model in one frame: rendered at the pose, paired where the depths agree.
+std::vector<ColorPair> PairsInFrame(const ColorcalArgs& args, const FrameSpec& spec, Renderer& renderer, MeshId id) {
+  const LoadedFrame frame = LoadFrame(spec);
+  const std::string frame_name = FrameName(spec);
+  const Eigen::Isometry3d camera_from_object = PoseInFrame(args, frame, frame_name);
   RenderOptions render_options;
   render_options.shading = Shading::kUnlit;  // as the model library renders its views
   const RenderResult render = renderer.Render(id, frame.rgbd.camera, camera_from_object, render_options);
@@ -151,20 +149,51 @@ int RunAuto(const ColorcalArgs& args) {
             << Fixed(1000.0 * args.max_depth_difference_m, 1) << " mm, " << pose_pairs.pairs.size()
             << " pairs (skipped: " << pose_pairs.window_outside << " at the mask's edge, " << pose_pairs.dark
             << " dark, " << pose_pairs.saturated << " saturated)\n";
-  if (pose_pairs.pairs.size() < 3) {
-    throw InputError("only " + std::to_string(pose_pairs.pairs.size()) + " colour pairs of \"" + args.model +
-                     "\" in frame " + frame_name +
+  return pose_pairs.pairs;
+}
+
+int RunAuto(const ColorcalArgs& args) {
+  ModelDatabase database(args.db, OpenMode::kReadWrite);
+  const ModelSummary model = FindModelOrThrow(database, args.model);
+  if (args.frames.size() > 1 && !args.pose_path.empty()) {
+    throw InputError("--pose " + args.pose_path + " is one frame's pose, but " + std::to_string(args.frames.size()) +
+                     " frames were given: use frames with ground truth, or one frame");
+  }
+  std::vector<FrameSpec> specs;
+  for (const std::string& path : args.frames) {
+    specs.push_back(args.frame);
+    specs.back().positional = path;
+  }
+  if (specs.empty()) specs.push_back(args.frame);
+
+  MeshLoadOptions mesh_options;
+  mesh_options.metres_per_unit = MetresPerUnit(model.unit);
+  mesh_options.object_from_mesh = model.object_from_mesh;
+  mesh_options.allow_missing_textures = true;
+  std::vector<std::string> warnings;
+  const TriangleMesh mesh = LoadMesh(model.mesh_path, mesh_options, &warnings);
+  for (const std::string& warning : warnings) std::cerr << "ecvpose: warning: " << warning << '\n';
+  Renderer renderer;
+  const MeshId id = renderer.AddMesh(mesh);
+
+  std::vector<ColorPair> pairs;  // pooled over the frames
+  std::string source = "auto:";
+  for (const FrameSpec& spec : specs) {
+    const std::vector<ColorPair> frame_pairs = PairsInFrame(args, spec, renderer, id);
+    pairs.insert(pairs.end(), frame_pairs.begin(), frame_pairs.end());
+    source += (&spec == &specs.front() ? "" : "+") + FrameName(spec);
+  }
+  if (pairs.size() < 3) {
+    throw InputError("only " + std::to_string(pairs.size()) + " colour pairs of \"" + args.model + "\" in " +
+                     source.substr(5) +
                      " (the model is not seen there, or the pose or depth is wrong); need at least 3");
   }
-
-  ColorFitOptions options;
-  options.method = MethodArgument(args.method);
-  options.Check();
-  const ColorFit fit = FitColorMatrix(pose_pairs.pairs, options);
-  PrintFit(fit, pose_pairs.pairs.size(), options.method);
-  std::cout << "mean colour error: " << Fixed(MeanColorError(pose_pairs.pairs), 6) << " -> "
-            << Fixed(MeanColorError(pose_pairs.pairs, fit.A), 6) << '\n';
-  Store(database, args.model, fit, "auto:" + frame_name);
+  const ColorFitOptions options = FitOptions(args);
+  const ColorFit fit = FitColorMatrix(pairs, options);
+  PrintFit(fit, pairs.size(), options.method);
+  std::cout << "mean colour error: " << Fixed(MeanColorError(pairs), 6) << " -> "
+            << Fixed(MeanColorError(pairs, fit.A), 6) << '\n';
+  Store(database, args.model, fit, source);
   return kExitOk;
 }
 
@@ -208,6 +237,14 @@ void AddMethodFlag(CLI::App& command, ColorcalArgs* args) {
                   "ransac (robust to mislabelled pairs), irls (Tukey reweighting) or lsq (plain least squares)")
       ->check(CLI::IsMember({"ransac", "irls", "lsq"}))
       ->capture_default_str();
+  command
+      .add_option("--form", args->form,
+                  "full (3x3), diagonal (per-channel gains) or auto (diagonal when the colours are of one hue)")
+      ->check(CLI::IsMember({"full", "diagonal", "auto"}))
+      ->capture_default_str();
+  command.add_flag("--keep-brightness,!--no-keep-brightness", args->keep_brightness,
+                   "Scale A so that the model's colours keep their brightness (correct the balance, not the exposure; "
+                   "the default, for matching); --no-keep-brightness stores A c_model = c_scene as fitted");
 }
 
 }  // namespace
@@ -224,8 +261,9 @@ CommandAction SetupColorcalCommand(CLI::App& command) {
   CLI::App* automatic = AddModelCommand(
       command, "auto", "Fit from a frame where the model's pose is known (render, depth agreement) and store it",
       args.get());
-  automatic->add_option("FRAME", args->frame.positional,
-                        "Frame JSON, YCB-Video prefix, BOP SCENE_DIR:IMAGE_ID or organized .pcd");
+  automatic->add_option("FRAME", args->frames,
+                        "Frame JSON, YCB-Video prefix, BOP SCENE_DIR:IMAGE_ID or organized .pcd; several: the pairs of "
+                        "all are pooled into one fit");
   AddFrameFlags(*automatic, &args->frame);
   automatic->add_option("--pose", args->pose_path,
                         "Pose JSON with key camera_from_object (default: the frame's ground truth of the model)");

@@ -116,8 +116,12 @@ class Recognizer::Impl {
       records_.push_back(model.record);
       ModelRecord& record = records_.back();
       if (options_.use_color_matrix && model.color_matrix) {
+        // Scaled to keep grey's brightness: a gain below 1 shrinks the colour differences the descriptor bins,
+        // which are not smaller in real frames (bench/RESULTS.md, colour calibration). Matrices stored by
+        // `ecvpose colorcal` keep the brightness already; this covers --no-keep-brightness and older libraries.
+        const Eigen::Matrix3d to_scene = BrightnessPreserving(model.color_matrix->model_to_scene);
         for (ModelView& view : record.views) {
-          ApplyColorMatrix(model.color_matrix->model_to_scene, &view.primitives);
+          ApplyColorMatrix(to_scene, &view.primitives);
           view.descriptors = ComputeDescriptors(view.primitives, library_.feature_settings().descriptor);
         }
       }

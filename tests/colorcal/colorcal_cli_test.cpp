@@ -1,5 +1,6 @@
 // `ecvpose colorcal` (issue 8): fit from an RGB-triplet CSV with a known matrix, automatic fit on the demo frame at
-// the ground-truth pose, show, clear, and the errors for an unknown model and a missing pose.
+// the ground-truth pose, on several frames pooled, with the diagonal form; show, clear, and the errors for an unknown
+// model and a missing pose.
 
 #include <cstdio>
 #include <optional>
@@ -73,8 +74,9 @@ TEST_F(ColorcalCliTest, FitRecoversAKnownMatrixFromTriplets) {
 
   for (const char* method : {"lsq", "ransac", "irls"}) {
     SCOPED_TRACE(method);
-    const test::CommandResult result = test::RunCli("colorcal fit --db " + library_ + " --model " + kModel +
-                                                    " --pairs " + csv + " --method " + method);
+    const test::CommandResult result =
+        test::RunCli("colorcal fit --db " + library_ + " --model " + kModel + " --pairs " + csv + " --method " +
+                     method + " --form full --no-keep-brightness");
     ASSERT_EQ(result.exit_code, 0) << result.output;
     EXPECT_NE(result.output.find("inliers: 30/30"), std::string::npos) << result.output;
     const std::optional<ColorMatrixRecord> stored = StoredMatrix();
@@ -87,7 +89,7 @@ TEST_F(ColorcalCliTest, FitRecoversAKnownMatrixFromTriplets) {
 
 TEST_F(ColorcalCliTest, AutoFitsOnTheFrameThenShowAndClear) {
   const test::CommandResult fitted =
-      test::RunCli("colorcal auto --db " + library_ + " --model " + kModel + " " + kFrame);
+      test::RunCli("colorcal auto --db " + library_ + " --model " + kModel + " " + kFrame + " --no-keep-brightness");
   ASSERT_EQ(fitted.exit_code, 0) << fitted.output;
   const std::vector<double> errors = MeanErrors(fitted.output);
   ASSERT_EQ(errors.size(), 2U) << fitted.output;
@@ -112,6 +114,44 @@ TEST_F(ColorcalCliTest, AutoFitsOnTheFrameThenShowAndClear) {
   const test::CommandResult empty = test::RunCli("colorcal show --db " + library_ + " --model " + kModel);
   EXPECT_EQ(empty.exit_code, 0) << empty.output;
   EXPECT_NE(empty.output.find("no colour matrix"), std::string::npos) << empty.output;
+}
+
+// Several frames: the pairs of each are pooled into one fit, and the stored source names every frame. The defaults
+// store per-channel gains scaled to keep the brightness (the frames are darker than the texture: scale above 1).
+TEST_F(ColorcalCliTest, AutoPoolsThePairsOfSeveralFrames) {
+  const std::string first = test::DataPath("ycbv_subset/Example-Scenes/0001/000001");
+  const std::string second = test::DataPath("ycbv_subset/Example-Scenes/0001/000011");
+  const test::CommandResult single =
+      test::RunCli("colorcal auto --db " + library_ + " --model " + kModel + " " + first);
+  ASSERT_EQ(single.exit_code, 0) << single.output;
+  const test::CommandResult pooled = test::RunCli("colorcal auto --db " + library_ + " --model " + kModel + " " +
+                                                  first + " " + second);  // defaults: diagonal, brightness kept
+  ASSERT_EQ(pooled.exit_code, 0) << pooled.output;
+  EXPECT_NE(pooled.output.find(kModel + " in 0001/000001: "), std::string::npos) << pooled.output;
+  EXPECT_NE(pooled.output.find(kModel + " in 0001/000011: "), std::string::npos) << pooled.output;
+  EXPECT_NE(pooled.output.find("form: diagonal"), std::string::npos) << pooled.output;
+  EXPECT_NE(pooled.output.find("brightness kept: A scaled by 1."), std::string::npos) << pooled.output;
+  // Each frame gives up to 2000 pairs: the pooled fit counts both frames' pairs.
+  const size_t at = pooled.output.find("inliers: ");
+  ASSERT_NE(at, std::string::npos) << pooled.output;
+  int inliers = 0, total = 0;
+  ASSERT_EQ(std::sscanf(pooled.output.c_str() + at, "inliers: %d/%d", &inliers, &total), 2) << pooled.output;
+  EXPECT_GT(total, 2000) << pooled.output;
+  const std::optional<ColorMatrixRecord> stored = StoredMatrix();
+  ASSERT_TRUE(stored);
+  EXPECT_EQ(stored->source, "auto:0001/000001+0001/000011");
+  const Eigen::Matrix3d& A = stored->model_to_scene;
+  EXPECT_EQ(A(0, 1), 0.0);
+  EXPECT_EQ(A(1, 0), 0.0);
+  EXPECT_EQ(A(2, 0), 0.0);
+  EXPECT_GT(A.diagonal().minCoeff(), 0.0) << A;  // gains, not the full form's extrapolation
+
+  // One --pose cannot hold for two frames.
+  const test::CommandResult two_poses = test::RunCli("colorcal auto --db " + library_ + " --model " + kModel + " " +
+                                                     first + " " + second + " --pose " + directory_->File("p.json"));
+  EXPECT_EQ(two_poses.exit_code, 1) << two_poses.output;
+  EXPECT_NE(two_poses.output.find("--pose"), std::string::npos) << two_poses.output;
+  ModelDatabase(library_, OpenMode::kReadWrite).ClearColorMatrix(kModel);
 }
 
 TEST_F(ColorcalCliTest, UnknownModelAndMissingPoseAreInputErrors) {
