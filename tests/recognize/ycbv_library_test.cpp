@@ -102,5 +102,25 @@ TEST_F(YcbvLibrary, SameSeedSameOutputWithOneOrTwoThreads) {
   for (size_t i = 0; i < one.size(); ++i) EXPECT_EQ(one[i].at("detections"), two[i].at("detections")) << i;
 }
 
+TEST_F(YcbvLibrary, BrokenFrameInSequenceIsReportedAndTheOthersAreProcessed) {
+  const std::string list = directory_->File("broken.txt"), out = directory_->File("broken.jsonl");
+  const std::string missing = directory_->File("no_such_video/000001");
+  std::ofstream(list) << Frames()[0] << '\n' << missing << '\n' << Frames()[1] << '\n';
+  const test::CommandResult run =
+      test::RunCli("recognize --db " + library_ + " --sequence " + list + " --out-json " + out);
+  EXPECT_EQ(run.exit_code, 1) << run.output;  // bad input, reported at the end
+  EXPECT_NE(run.output.find(missing), std::string::npos) << run.output;
+  std::ifstream in(out);
+  std::vector<nlohmann::json> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(nlohmann::json::parse(line));
+  ASSERT_EQ(lines.size(), 3U);
+  EXPECT_EQ(lines[1].at("frame"), missing);
+  EXPECT_NE(lines[1].at("error").get<std::string>().find(missing), std::string::npos);
+  for (const size_t i : {0U, 2U}) {
+    EXPECT_FALSE(lines[i].contains("error")) << lines[i].dump();
+    EXPECT_FALSE(lines[i].at("detections").empty()) << lines[i].dump();  // gelatin box; cracker box
+  }
+}
+
 }  // namespace
 }  // namespace ecv
