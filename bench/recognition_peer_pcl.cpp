@@ -88,13 +88,10 @@ class PclPeer : public RecognitionPeer {
       Detection detection;
       if (Align(model, scene, &detection)) {
         detection.inlier_fraction = InlierFraction(model.points, detection.camera_from_object, scene_grid);
-        detection.score = detection.inlier_fraction;
-        if (detection.inlier_fraction >= options_.min_inlier_fraction) result.detections.push_back(detection);
+        KeepIfAccepted(detection, options_, &result);
       }
     }
-    std::sort(result.detections.begin(), result.detections.end(),
-              [](const Detection& a, const Detection& b) { return a.score > b.score; });
-    result.time_ms = MillisecondsSince(start);
+    FinishPeerResult(start, &result);
     return result;
   }
 

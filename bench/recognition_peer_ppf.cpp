@@ -115,12 +115,9 @@ class PpfPeer : public RecognitionPeer {
           detection.fit_error_m = poses[0]->residual;
         }
       }
-      detection.score = detection.inlier_fraction;
-      if (detection.inlier_fraction >= options_.min_inlier_fraction) result.detections.push_back(detection);
+      KeepIfAccepted(detection, options_, &result);
     }
-    std::sort(result.detections.begin(), result.detections.end(),
-              [](const Detection& a, const Detection& b) { return a.score > b.score; });
-    result.time_ms = MillisecondsSince(start);
+    FinishPeerResult(start, &result);
     return result;
   }
 

@@ -147,6 +147,17 @@ std::vector<Eigen::Vector3f> SceneCloud(const RgbdFrame& frame, double voxel_m) 
   return voxelised;
 }
 
+void KeepIfAccepted(Detection detection, const PeerOptions& options, PeerResult* result) {
+  detection.score = detection.inlier_fraction;
+  if (detection.inlier_fraction >= options.min_inlier_fraction) result->detections.push_back(detection);
+}
+
+void FinishPeerResult(Clock::time_point start, PeerResult* result) {
+  std::sort(result->detections.begin(), result->detections.end(),
+            [](const Detection& a, const Detection& b) { return a.score > b.score; });
+  result->time_ms = MillisecondsSince(start);
+}
+
 double InlierFraction(const std::vector<Eigen::Vector3f>& object_points, const Eigen::Isometry3d& camera_from_object,
                       const RadiusGrid& scene) {
   if (object_points.empty()) return 0.0;

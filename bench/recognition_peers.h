@@ -12,6 +12,7 @@
 
 #include "core/frame.h"
 #include "core/point_index.h"
+#include "core/timing.h"
 #include "modeldb/model_record.h"
 #include "recognize/recognizer.h"
 
@@ -86,6 +87,12 @@ std::vector<Eigen::Vector3f> SceneCloud(const RgbdFrame& frame, double voxel_m);
 void VoxelDownsample(const std::vector<Eigen::Vector3f>& points, const std::vector<Eigen::Vector3f>& normals,
                      double voxel_m, std::vector<Eigen::Vector3f>* out_points,
                      std::vector<Eigen::Vector3f>* out_normals);
+
+/// Adds `detection` to `result` when its score (its inlier fraction) reaches the options' minimum.
+void KeepIfAccepted(Detection detection, const PeerOptions& options, PeerResult* result);
+
+/// Sorts the result's detections best first and stamps the frame's time since `start`.
+void FinishPeerResult(Clock::time_point start, PeerResult* result);
 
 /// Share of `object_points` that lie, under `camera_from_object`, within the grid's radius of a scene point.
 double InlierFraction(const std::vector<Eigen::Vector3f>& object_points, const Eigen::Isometry3d& camera_from_object,
