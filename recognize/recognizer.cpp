@@ -138,42 +138,15 @@ class Recognizer::Impl {
     const Clock::time_point start = Clock::now();
     RecognitionResult result;
     const Scene scene = PrepareScene(frame, &result);
-    Clock::time_point stage;
-    std::vector<std::pair<size_t, Detection>> candidates;  // (model, its best detection)
-    stage = Clock::now();
+    Clock::time_point stage = Clock::now();
     const std::vector<std::vector<ViewCandidate>> ranked = RankAllViews(scene);
     result.timings_ms["match"] += MillisecondsSince(stage);
+    std::vector<std::pair<size_t, Detection>> candidates;  // (model, its best detection)
     for (size_t m = 0; m < library_.models().size(); ++m) {
-      stage = Clock::now();
-      std::vector<Hypothesis> hypotheses = EstimatePoses(records_[m], ranked[m], scene);
-      result.timings_ms["ransac"] += MillisecondsSince(stage);
-
-      // Every hypothesis is verified as it is; the best one is refined and verified again.
-      stage = Clock::now();
-      std::optional<Detection> best;
-      Hypothesis* best_hypothesis = nullptr;
-      for (Hypothesis& hypothesis : hypotheses) {
-        Detection detection = Verify(m, scene, hypothesis);
-        if (!best || detection.score > best->score) {
-          best = detection;
-          best_hypothesis = &hypothesis;
-        }
+      const std::optional<Detection> best = BestDetection(m, ranked[m], scene, &result.timings_ms);
+      if (best && best->score >= options_.min_score && best->visible_fraction >= options_.min_visible_fraction) {
+        candidates.emplace_back(m, *best);
       }
-      result.timings_ms["verify"] += MillisecondsSince(stage);
-      if (best_hypothesis != nullptr && options_.refine) {
-        stage = Clock::now();
-        Hypothesis refined = *best_hypothesis;
-        Refine(m, scene, &refined);
-        result.timings_ms["refine"] += MillisecondsSince(stage);
-        stage = Clock::now();
-        const Detection detection = Verify(m, scene, refined);
-        if (detection.score >= best->score) best = detection;  // ICP must not make the pose worse
-        result.timings_ms["verify"] += MillisecondsSince(stage);
-      }
-      if (best && (best->score < options_.min_score || best->visible_fraction < options_.min_visible_fraction)) {
-        best.reset();
-      }
-      if (best) candidates.emplace_back(m, *best);
     }
     stage = Clock::now();
     result.detections = SuppressOverlaps(scene, std::move(candidates));
@@ -218,6 +191,38 @@ class Recognizer::Impl {
     scene.visibility.depth = frame.depth;
     scene.visibility.camera = frame.camera;
     return scene;
+  }
+
+  // The model's best pose over its ranked views: RANSAC per view, each pose verified as it is, the best one
+  // refined by ICP and verified again (kept only if ICP does not lower its score). Adds stage times.
+  std::optional<Detection> BestDetection(size_t model, const std::vector<ViewCandidate>& views, const Scene& scene,
+                                         std::map<std::string, double>* timings_ms) {
+    Clock::time_point stage = Clock::now();
+    std::vector<Hypothesis> hypotheses = EstimatePoses(records_[model], views, scene);
+    (*timings_ms)["ransac"] += MillisecondsSince(stage);
+
+    stage = Clock::now();
+    std::optional<Detection> best;
+    const Hypothesis* best_hypothesis = nullptr;
+    for (const Hypothesis& hypothesis : hypotheses) {
+      Detection detection = Verify(model, scene, hypothesis);
+      if (!best || detection.score > best->score) {
+        best = detection;
+        best_hypothesis = &hypothesis;
+      }
+    }
+    (*timings_ms)["verify"] += MillisecondsSince(stage);
+    if (best_hypothesis == nullptr || !options_.refine) return best;
+
+    stage = Clock::now();
+    Hypothesis refined = *best_hypothesis;
+    Refine(model, scene, &refined);
+    (*timings_ms)["refine"] += MillisecondsSince(stage);
+    stage = Clock::now();
+    const Detection detection = Verify(model, scene, refined);
+    if (detection.score >= best->score) best = detection;
+    (*timings_ms)["verify"] += MillisecondsSince(stage);
+    return best;
   }
 
   // RankViews of every model, the models shared out over RansacOptions::threads workers (each model's
