@@ -46,10 +46,13 @@ class YcbvLibrary : public ::testing::Test {
     return {scenes + "0000/000001", scenes + "0001/000001", scenes + "0002/000001"};
   }
 
-  // `recognize --sequence` over Frames(); the JSON lines, one per frame.
-  static std::vector<nlohmann::json> Recognize(const std::string& tag, const std::string& flags) {
+  // `recognize --sequence` over `frames`; the JSON lines, one per frame.
+  static std::vector<nlohmann::json> Recognize(const std::string& tag, const std::string& flags,
+                                               const std::vector<std::string>& frames = Frames()) {
     const std::string list = directory_->File(tag + ".txt"), out = directory_->File(tag + ".jsonl");
-    std::ofstream(list) << Frames()[0] << '\n' << Frames()[1] << '\n' << Frames()[2] << '\n';
+    std::ofstream list_file(list);
+    for (const std::string& frame : frames) list_file << frame << '\n';
+    list_file.close();
     const test::CommandResult run =
         test::RunCli("recognize --db " + library_ + " --sequence " + list + " --out-json " + out + " " + flags);
     EXPECT_EQ(run.exit_code, 0) << run.output;
@@ -96,8 +99,10 @@ TEST_F(YcbvLibrary, FindsTexturedObjectsOnThreeVideosWithoutFalsePositives) {
 }
 
 TEST_F(YcbvLibrary, SameSeedSameOutputWithOneOrTwoThreads) {
-  const std::vector<nlohmann::json> one = Recognize("one", "--threads 1 --seed 7");
-  const std::vector<nlohmann::json> two = Recognize("two", "--threads 2 --seed 7");
+  // Not the dense close-up of 0000: the sanitizer build runs this too.
+  const std::vector<std::string> frames = {Frames()[1], Frames()[2]};
+  const std::vector<nlohmann::json> one = Recognize("one", "--threads 1 --seed 7", frames);
+  const std::vector<nlohmann::json> two = Recognize("two", "--threads 2 --seed 7", frames);
   ASSERT_EQ(one.size(), two.size());
   for (size_t i = 0; i < one.size(); ++i) EXPECT_EQ(one[i].at("detections"), two[i].at("detections")) << i;
 }
