@@ -10,24 +10,33 @@ namespace {
 
 static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "descriptors are stored as little-endian float32");
 
-// Every field of the options (a field added to EcvOptions or DescriptorOptions must be added here too, or a
-// library would not record it).
+// Every field of the options, once, for writing and reading alike: visit(group, key, field). A field added
+// to EcvOptions or DescriptorOptions must be added here too, or a library would not record it.
+template <typename Settings, typename Visit>
+void VisitFields(Settings& settings, Visit visit) {
+  auto& e = settings.ecv;
+  visit("ecv", "wavelength_px", e.monogenic.wavelength_px);
+  visit("ecv", "sigma_on_f", e.monogenic.sigma_on_f);
+  visit("ecv", "grid_spacing_px", e.grid_spacing_px);
+  visit("ecv", "min_magnitude", e.min_magnitude);
+  visit("ecv", "max_edge_variance", e.max_edge_variance);
+  visit("ecv", "edge_nms", e.edge_nms);
+  visit("ecv", "surface_radius_m", e.surface_radius_m);
+  visit("ecv", "depth_gap_m", e.depth_gap_m);
+  visit("ecv", "color_radius_px", e.color_radius_px);
+  auto& d = settings.descriptor;
+  visit("descriptor", "radius_m", d.radius_m);
+  visit("descriptor", "max_neighbours", d.max_neighbours);
+  visit("descriptor", "unsigned_segments", d.unsigned_segments);
+  visit("descriptor", "soft_binning", d.soft_binning);
+  visit("descriptor", "use_color", d.use_color);
+  visit("descriptor", "balance_colors", d.balance_colors);
+  visit("descriptor", "hellinger", d.hellinger);
+}
+
 nlohmann::ordered_json ToJson(const FeatureSettings& settings) {
-  const EcvOptions& e = settings.ecv;
-  const DescriptorOptions& d = settings.descriptor;
   nlohmann::ordered_json json;
-  json["ecv"] = {{"wavelength_px", e.monogenic.wavelength_px}, {"sigma_on_f", e.monogenic.sigma_on_f},
-                 {"grid_spacing_px", e.grid_spacing_px},       {"min_magnitude", e.min_magnitude},
-                 {"max_edge_variance", e.max_edge_variance},   {"edge_nms", e.edge_nms},
-                 {"surface_radius_m", e.surface_radius_m},     {"depth_gap_m", e.depth_gap_m},
-                 {"color_radius_px", e.color_radius_px}};
-  json["descriptor"] = {{"radius_m", d.radius_m},
-                        {"max_neighbours", d.max_neighbours},
-                        {"unsigned_segments", d.unsigned_segments},
-                        {"soft_binning", d.soft_binning},
-                        {"use_color", d.use_color},
-                        {"balance_colors", d.balance_colors},
-                        {"hellinger", d.hellinger}};
+  VisitFields(settings, [&](const char* group, const char* key, const auto& field) { json[group][key] = field; });
   return json;
 }
 
@@ -67,24 +76,9 @@ FeatureSettings FeatureSettingsFromJson(const std::string& text, const std::stri
   const nlohmann::json descriptor = json.value("descriptor", nlohmann::json::object());
   RejectUnknown(ecv, known["ecv"], source + ": ecv");
   RejectUnknown(descriptor, known["descriptor"], source + ": descriptor");
-  EcvOptions& e = settings.ecv;
-  Read(ecv, "wavelength_px", &e.monogenic.wavelength_px, source);
-  Read(ecv, "sigma_on_f", &e.monogenic.sigma_on_f, source);
-  Read(ecv, "grid_spacing_px", &e.grid_spacing_px, source);
-  Read(ecv, "min_magnitude", &e.min_magnitude, source);
-  Read(ecv, "max_edge_variance", &e.max_edge_variance, source);
-  Read(ecv, "edge_nms", &e.edge_nms, source);
-  Read(ecv, "surface_radius_m", &e.surface_radius_m, source);
-  Read(ecv, "depth_gap_m", &e.depth_gap_m, source);
-  Read(ecv, "color_radius_px", &e.color_radius_px, source);
-  DescriptorOptions& d = settings.descriptor;
-  Read(descriptor, "radius_m", &d.radius_m, source);
-  Read(descriptor, "max_neighbours", &d.max_neighbours, source);
-  Read(descriptor, "unsigned_segments", &d.unsigned_segments, source);
-  Read(descriptor, "soft_binning", &d.soft_binning, source);
-  Read(descriptor, "use_color", &d.use_color, source);
-  Read(descriptor, "balance_colors", &d.balance_colors, source);
-  Read(descriptor, "hellinger", &d.hellinger, source);
+  VisitFields(settings, [&](const std::string& group, const char* key, auto& field) {
+    Read(group == "ecv" ? ecv : descriptor, key, &field, source);
+  });
   return settings;
 }
 
