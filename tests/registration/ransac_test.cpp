@@ -74,6 +74,43 @@ TEST(Ransac, FindsThePoseAmongNinetyPercentOutliers) {
   }
 }
 
+// Local sampling (sample_radius_m): the object is small in a large cluttered scene, 5 % of the correspondences
+// are true and the false ones lead into the clutter, at least 0.5 m away. Drawing a sample's later members
+// within the object's size of its first makes a true first member enough; uniform sampling needs all three.
+TEST(Ransac, LocalSamplingFindsASmallObjectInClutterWithFewIterations) {
+  Problem problem = MakeProblem(300, 0, 0, 0.0005, 4);
+  std::mt19937 random(5);
+  std::uniform_real_distribution<float> coordinate(-1.0F, 1.0F);
+  const Eigen::Vector3f centre = problem.scene_from_object.cast<float>() * Eigen::Vector3f::Constant(0.075F);
+  while (problem.scene.size() < 3300) {  // clutter, none within 0.5 m of the object
+    const Eigen::Vector3f point = centre + Eigen::Vector3f(coordinate(random), coordinate(random), coordinate(random));
+    if ((point - centre).norm() > 0.5F) problem.scene.push_back(point);
+  }
+  std::uniform_int_distribution<int> object(0, 299), clutter(300, 3299);
+  for (int i = 0; i < 600; ++i) {
+    const int o = object(random);
+    problem.correspondences.push_back({o, i < 30 ? o : clutter(random)});
+  }
+  std::shuffle(problem.correspondences.begin(), problem.correspondences.end(), random);
+
+  RansacOptions options;
+  options.max_iterations = 400;
+  options.inlier_threshold_m = 0.003;
+  RansacOptions local = options;
+  local.sample_radius_m = 0.3;  // about twice the object's size
+  const RansacResult found = EstimatePoseRansac(problem.object, problem.scene, problem.correspondences, local);
+  ASSERT_TRUE(found.success);
+  EXPECT_LT(TranslationDistance(found.scene_from_object, problem.scene_from_object), 0.001);
+  EXPECT_LT(RotationAngle(found.scene_from_object, problem.scene_from_object), 0.5 * kDegree);
+
+  const RansacResult uniform = EstimatePoseRansac(problem.object, problem.scene, problem.correspondences, options);
+  EXPECT_FALSE(uniform.success && TranslationDistance(uniform.scene_from_object, problem.scene_from_object) < 0.001)
+      << "uniform sampling: an all-true sample has probability 0.05^3 per iteration";
+
+  local.sample_radius_m = -0.1;
+  EXPECT_THROW(EstimatePoseRansac(problem.object, problem.scene, problem.correspondences, local), InputError);
+}
+
 TEST(Ransac, PolygonTestKeepsTrueSamplesAndRejectsRandomOnes) {
   const Problem problem = MakeProblem(400, 0, 0, 0.002, 2);  // 2 mm noise
   const PolygonEdgeCheck check(0.25);
