@@ -63,6 +63,13 @@ Descriptors SampleRows(const Descriptors& descriptors, size_t count, uint64_t se
   return subset;
 }
 
+// A verified pose: the detection and the pixels (at dense_stride_px) where its rendered surface lies on the
+// scene's, which overlap suppression compares.
+struct Verified {
+  Detection detection;
+  std::vector<cv::Point> surface;
+};
+
 // A pose hypothesis of a model from one of its views.
 struct Hypothesis {
   int view = -1;
@@ -141,15 +148,16 @@ class Recognizer::Impl {
     Clock::time_point stage = Clock::now();
     const std::vector<std::vector<ViewCandidate>> ranked = RankAllViews(scene);
     result.timings_ms["match"] += MillisecondsSince(stage);
-    std::vector<std::pair<size_t, Detection>> candidates;  // (model, its best detection)
+    std::vector<Verified> candidates;  // each model's best detection
     for (size_t m = 0; m < library_.models().size(); ++m) {
-      const std::optional<Detection> best = BestDetection(m, ranked[m], scene, &result.timings_ms);
-      if (best && best->score >= options_.min_score && best->visible_fraction >= options_.min_visible_fraction) {
-        candidates.emplace_back(m, *best);
+      std::optional<Verified> best = BestDetection(m, ranked[m], scene, &result.timings_ms);
+      if (best && best->detection.score >= options_.min_score &&
+          best->detection.visible_fraction >= options_.min_visible_fraction) {
+        candidates.push_back(std::move(*best));
       }
     }
     stage = Clock::now();
-    result.detections = SuppressOverlaps(scene, std::move(candidates));
+    result.detections = SuppressOverlaps(frame.depth.size(), std::move(candidates));
     result.timings_ms["verify"] += MillisecondsSince(stage);
     result.timings_ms["total"] = MillisecondsSince(start);
     return result;
@@ -195,19 +203,19 @@ class Recognizer::Impl {
 
   // The model's best pose over its ranked views: RANSAC per view, each pose verified as it is, the best one
   // refined by ICP and verified again (kept only if ICP does not lower its score). Adds stage times.
-  std::optional<Detection> BestDetection(size_t model, const std::vector<ViewCandidate>& views, const Scene& scene,
-                                         std::map<std::string, double>* timings_ms) {
+  std::optional<Verified> BestDetection(size_t model, const std::vector<ViewCandidate>& views, const Scene& scene,
+                                        std::map<std::string, double>* timings_ms) {
     Clock::time_point stage = Clock::now();
     std::vector<Hypothesis> hypotheses = EstimatePoses(records_[model], views, scene);
     (*timings_ms)["ransac"] += MillisecondsSince(stage);
 
     stage = Clock::now();
-    std::optional<Detection> best;
+    std::optional<Verified> best;
     const Hypothesis* best_hypothesis = nullptr;
     for (const Hypothesis& hypothesis : hypotheses) {
-      Detection detection = Verify(model, scene, hypothesis);
-      if (!best || detection.score > best->score) {
-        best = detection;
+      Verified verified = Verify(model, scene, hypothesis);
+      if (!best || verified.detection.score > best->detection.score) {
+        best = std::move(verified);
         best_hypothesis = &hypothesis;
       }
     }
@@ -219,8 +227,8 @@ class Recognizer::Impl {
     Refine(model, scene, &refined);
     (*timings_ms)["refine"] += MillisecondsSince(stage);
     stage = Clock::now();
-    const Detection detection = Verify(model, scene, refined);
-    if (detection.score >= best->score) best = detection;
+    Verified verified = Verify(model, scene, refined);
+    if (verified.detection.score >= best->detection.score) best = std::move(verified);
     (*timings_ms)["verify"] += MillisecondsSince(stage);
     return best;
   }
@@ -328,36 +336,25 @@ class Recognizer::Impl {
 
   // The detections, best first, without those whose rendered surface lies mostly (max_overlap) on scene
   // pixels that a better detection of another model already explains: one surface, one object.
-  std::vector<Detection> SuppressOverlaps(const Scene& scene, std::vector<std::pair<size_t, Detection>> candidates) {
+  std::vector<Detection> SuppressOverlaps(const cv::Size& image_size, std::vector<Verified> candidates) const {
     std::stable_sort(candidates.begin(), candidates.end(),
-                     [](const auto& a, const auto& b) { return a.second.score > b.second.score; });
-    const cv::Mat& scene_depth = scene.frame->depth;
-    cv::Mat explained = cv::Mat::zeros(scene_depth.size(), CV_8UC1);
+                     [](const Verified& a, const Verified& b) { return a.detection.score > b.detection.score; });
+    cv::Mat explained = cv::Mat::zeros(image_size, CV_8UC1);
     std::vector<Detection> kept;
-    for (const auto& [model, detection] : candidates) {
-      const RenderResult rendered = renderer_.Render(meshes_[model], scene.frame->camera, detection.camera_from_object);
-      std::vector<cv::Point> surface;  // the model's pixels on the scene surface
-      for (int v = 0; v < rendered.depth.rows; v += options_.dense_stride_px) {
-        for (int u = 0; u < rendered.depth.cols; u += options_.dense_stride_px) {
-          const float model_z = rendered.depth.at<float>(v, u), scene_z = scene_depth.at<float>(v, u);
-          if (model_z > 0.0F && scene_z > 0.0F &&
-              std::abs(scene_z - model_z) <= static_cast<float>(options_.depth_tolerance_m)) {
-            surface.emplace_back(u, v);
-          }
-        }
-      }
+    for (const Verified& candidate : candidates) {
+      const std::vector<cv::Point>& surface = candidate.surface;
       const auto taken = std::count_if(surface.begin(), surface.end(),
                                        [&](const cv::Point& p) { return explained.at<uchar>(p) != 0; });
       if (!surface.empty() && static_cast<double>(taken) > options_.max_overlap * static_cast<double>(surface.size())) {
         continue;
       }
       for (const cv::Point& p : surface) explained.at<uchar>(p) = 1;
-      kept.push_back(detection);
+      kept.push_back(candidate.detection);
     }
     return kept;
   }
 
-  Detection Verify(size_t model, const Scene& scene, const Hypothesis& hypothesis) {
+  Verified Verify(size_t model, const Scene& scene, const Hypothesis& hypothesis) {
     const LibraryModel& library_model = library_.models()[model];
     const RgbdFrame& frame = *scene.frame;
     const RenderResult rendered = renderer_.Render(meshes_[model], frame.camera, hypothesis.pose);
@@ -369,7 +366,8 @@ class Recognizer::Impl {
     if (options_.use_color_matrix && library_model.color_matrix) {
       to_scene = library_model.color_matrix->model_to_scene.cast<float>();
     }
-    int rendered_pixels = 0, visible = 0, on_surface = 0;
+    int rendered_pixels = 0, visible = 0;
+    Verified verified;
     std::vector<std::pair<Eigen::Vector3f, Eigen::Vector3f>> colors;  // (model through A, scene) on the surface
     const float tolerance = static_cast<float>(options_.depth_tolerance_m);
     for (int v = 0; v < rendered.depth.rows; v += options_.dense_stride_px) {
@@ -381,14 +379,15 @@ class Recognizer::Impl {
         if (scene_z <= 0.0F || scene_z < model_z - tolerance) continue;  // no measurement, or hidden
         ++visible;
         if (std::abs(scene_z - model_z) > tolerance) continue;
-        ++on_surface;
+        verified.surface.emplace_back(u, v);
         const cv::Vec3b& m = model_color.at<cv::Vec3b>(v, u);
         const cv::Vec3b& s = scene.color.at<cv::Vec3b>(v, u);
         colors.emplace_back(to_scene * Eigen::Vector3f(m[0], m[1], m[2]) / 255.0F,
                             Eigen::Vector3f(s[0], s[1], s[2]) / 255.0F);
       }
     }
-    Detection detection;
+    const int on_surface = static_cast<int>(verified.surface.size());
+    Detection& detection = verified.detection;
     detection.color_agreement = ColorCorrelation(colors);
     detection.model = library_model.record.name;
     detection.camera_from_object = hypothesis.pose;
@@ -398,7 +397,7 @@ class Recognizer::Impl {
     detection.visible_fraction = rendered_pixels > 0 ? static_cast<double>(visible) / rendered_pixels : 0.0;
     detection.depth_agreement = visible > 0 ? static_cast<double>(on_surface) / visible : 0.0;
     detection.score = detection.depth_agreement * detection.color_agreement;
-    return detection;
+    return verified;
   }
 
  public:
