@@ -63,12 +63,27 @@ Descriptors SampleRows(const Descriptors& descriptors, size_t count, uint64_t se
   return subset;
 }
 
-// A verified pose: the detection and the pixels (at dense_stride_px) where its rendered surface lies on the
-// scene's, which overlap suppression compares.
+// A verified pose: the detection, the pixels (at dense_stride_px) where its rendered surface lies on the
+// scene's, which overlap suppression compares, and the rendered surface in the object frame, which ICP fits.
 struct Verified {
   Detection detection;
   std::vector<cv::Point> surface;
+  std::vector<Eigen::Vector3f> object_points;
 };
+
+// `camera` with one pixel per `stride` pixels of it: its pixel (u, v) sees along the ray of `camera`'s pixel
+// (stride u, stride v), so rendering at it equals sampling every stride-th pixel of a full render.
+PinholeCamera SampledCamera(const PinholeCamera& camera, int stride) {
+  PinholeCamera sampled = camera;
+  const double scale = 1.0 / stride;
+  sampled.fx *= scale;
+  sampled.fy *= scale;
+  sampled.cx *= scale;
+  sampled.cy *= scale;
+  sampled.width = (camera.width + stride - 1) / stride;
+  sampled.height = (camera.height + stride - 1) / stride;
+  return sampled;
+}
 
 // A pose hypothesis of a model from one of its views.
 struct Hypothesis {
@@ -211,7 +226,7 @@ class Recognizer::Impl {
 
     stage = Clock::now();
     std::optional<Verified> best;
-    const Hypothesis* best_hypothesis = nullptr;
+    const Hypothesis* best_hypothesis = nullptr;  // of `best`
     for (const Hypothesis& hypothesis : hypotheses) {
       Verified verified = Verify(model, scene, hypothesis);
       if (!best || verified.detection.score > best->detection.score) {
@@ -222,9 +237,11 @@ class Recognizer::Impl {
     (*timings_ms)["verify"] += MillisecondsSince(stage);
     if (best_hypothesis == nullptr || !options_.refine) return best;
 
+    // Only the best verified pose is refined: refining the best three as well found 44 instead of 45 of the
+    // 70 YCB-Video objects, for 3x the ICP time.
     stage = Clock::now();
     Hypothesis refined = *best_hypothesis;
-    Refine(model, scene, &refined);
+    Refine(model, scene, best->object_points, &refined);
     (*timings_ms)["refine"] += MillisecondsSince(stage);
     stage = Clock::now();
     Verified verified = Verify(model, scene, refined);
@@ -307,24 +324,14 @@ class Recognizer::Impl {
     return hypotheses;
   }
 
-  // Point-to-plane ICP of the model's visible surface (rendered at the pose) against the scene points near it.
-  void Refine(size_t model, const Scene& scene, Hypothesis* hypothesis) {
-    const RgbdFrame& frame = *scene.frame;
-    const RenderResult rendered = renderer_.Render(meshes_[model], frame.camera, hypothesis->pose);
-    const Eigen::Isometry3f object_from_camera = hypothesis->pose.inverse().cast<float>();
-    std::vector<Eigen::Vector3f> object_points;
-    Eigen::Vector3f centre = Eigen::Vector3f::Zero();
-    for (int v = 0; v < rendered.depth.rows; v += options_.dense_stride_px) {
-      for (int u = 0; u < rendered.depth.cols; u += options_.dense_stride_px) {
-        const float z = rendered.depth.at<float>(v, u);
-        if (z <= 0.0F) continue;
-        const Eigen::Vector3f point = frame.camera.BackProject({u, v}, z).cast<float>();
-        centre += point;
-        object_points.push_back(object_from_camera * point);
-      }
-    }
+  // Point-to-plane ICP of the model's surface as rendered at the pose (`object_points`, object frame) against
+  // the scene points near it.
+  void Refine(size_t model, const Scene& scene, const std::vector<Eigen::Vector3f>& object_points,
+              Hypothesis* hypothesis) const {
     if (object_points.size() < 10) return;
-    centre /= static_cast<float>(object_points.size());
+    Eigen::Vector3f centre = Eigen::Vector3f::Zero();
+    for (const Eigen::Vector3f& point : object_points) centre += point;
+    centre = hypothesis->pose.cast<float>() * (centre / static_cast<float>(object_points.size()));
     const float radius = 0.5F * static_cast<float>(library_.models()[model].record.diameter_m) + 0.03F;
     std::vector<Eigen::Vector3f> near;
     for (size_t i = scene.primitives.size(); i < scene.points.size(); i += 2) {  // half the dense points suffice
@@ -357,11 +364,14 @@ class Recognizer::Impl {
   Verified Verify(size_t model, const Scene& scene, const Hypothesis& hypothesis) {
     const LibraryModel& library_model = library_.models()[model];
     const RgbdFrame& frame = *scene.frame;
-    const RenderResult rendered = renderer_.Render(meshes_[model], frame.camera, hypothesis.pose);
+    const int stride = options_.dense_stride_px;
+    const PinholeCamera camera = SampledCamera(frame.camera, stride);
+    const RenderResult rendered = renderer_.Render(meshes_[model], camera, hypothesis.pose);
     cv::Mat model_color = rendered.color;
     if (options_.color_blur_px > 0.0) {
-      cv::GaussianBlur(rendered.color, model_color, cv::Size(0, 0), options_.color_blur_px);
+      cv::GaussianBlur(rendered.color, model_color, cv::Size(0, 0), options_.color_blur_px / stride);
     }
+    const Eigen::Isometry3f object_from_camera = hypothesis.pose.inverse().cast<float>();
     Eigen::Matrix3f to_scene = Eigen::Matrix3f::Identity();
     if (options_.use_color_matrix && library_model.color_matrix) {
       to_scene = library_model.color_matrix->model_to_scene.cast<float>();
@@ -370,18 +380,20 @@ class Recognizer::Impl {
     Verified verified;
     std::vector<std::pair<Eigen::Vector3f, Eigen::Vector3f>> colors;  // (model through A, scene) on the surface
     const float tolerance = static_cast<float>(options_.depth_tolerance_m);
-    for (int v = 0; v < rendered.depth.rows; v += options_.dense_stride_px) {
-      for (int u = 0; u < rendered.depth.cols; u += options_.dense_stride_px) {
+    for (int v = 0; v < rendered.depth.rows; ++v) {
+      for (int u = 0; u < rendered.depth.cols; ++u) {
         const float model_z = rendered.depth.at<float>(v, u);
         if (model_z <= 0.0F) continue;
         ++rendered_pixels;
-        const float scene_z = frame.depth.at<float>(v, u);
+        verified.object_points.push_back(object_from_camera * camera.BackProject({u, v}, model_z).cast<float>());
+        const int scene_u = u * stride, scene_v = v * stride;
+        const float scene_z = frame.depth.at<float>(scene_v, scene_u);
         if (scene_z <= 0.0F || scene_z < model_z - tolerance) continue;  // no measurement, or hidden
         ++visible;
         if (std::abs(scene_z - model_z) > tolerance) continue;
-        verified.surface.emplace_back(u, v);
+        verified.surface.emplace_back(scene_u, scene_v);
         const cv::Vec3b& m = model_color.at<cv::Vec3b>(v, u);
-        const cv::Vec3b& s = scene.color.at<cv::Vec3b>(v, u);
+        const cv::Vec3b& s = scene.color.at<cv::Vec3b>(scene_v, scene_u);
         colors.emplace_back(to_scene * Eigen::Vector3f(m[0], m[1], m[2]) / 255.0F,
                             Eigen::Vector3f(s[0], s[1], s[2]) / 255.0F);
       }

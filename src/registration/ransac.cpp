@@ -201,34 +201,26 @@ class Estimator {
     }
   }
 
-  // Fills `inliers` for `pose`; false as soon as the required fraction can no longer be reached.
+  // Fills `inliers` for `pose`; false when fewer than the required fraction of the visible object points are
+  // inliers, or (preverify) as soon as the count falls clearly behind it. Visibility is tested point by point
+  // as they are checked, so a hypothesis dropped early costs a few dozen points, not all of them.
   bool FindInliers(const Eigen::Isometry3d& pose, Inliers* inliers) const {
     const Eigen::Isometry3f transform = pose.cast<float>();
     inliers->object.clear();
     inliers->scene.clear();
     inliers->distance_sum = 0.0;
-    inliers->visible = object_.size();
-    if (visibility_ != nullptr) {
-      inliers->visible = static_cast<size_t>(std::count_if(
-          object_.begin(), object_.end(), [&](const auto& point) { return Visible(*visibility_, transform * point); }));
-      if (static_cast<double>(inliers->visible) < visibility_->min_visible_fraction * object_.size()) return false;
-    }
-    const size_t required =
-        std::max<size_t>(3, static_cast<size_t>(std::ceil(options_.required_inlier_fraction * inliers->visible)));
     const float eps_squared = static_cast<float>(options_.inlier_threshold_m * options_.inlier_threshold_m);
     const double fraction = options_.required_inlier_fraction;
     const double spread = 3.0 * std::sqrt(fraction * (1.0 - fraction));  // 3 sigma of the binomial, per sqrt(k)
-    size_t remaining = inliers->visible, checked = 0;
+    size_t checked = 0;                                                  // visible object points so far
     for (const int index : order_) {
       const Eigen::Vector3f& point = object_[static_cast<size_t>(index)];
       const Eigen::Vector3f moved = transform * point;
       if (visibility_ != nullptr && !Visible(*visibility_, moved)) continue;
-      if (inliers->object.size() + remaining < required) return false;
       if (options_.preverify && checked >= 50 && checked % 16 == 0) {
         const double k = static_cast<double>(checked);
         if (static_cast<double>(inliers->object.size()) < fraction * k - spread * std::sqrt(k)) return false;
       }
-      --remaining;
       ++checked;
       const auto [nearest, squared] = tree_.NearestWithin(moved);
       if (squared > eps_squared) continue;
@@ -236,6 +228,13 @@ class Estimator {
       inliers->scene.push_back(scene_[static_cast<size_t>(nearest)]);
       inliers->distance_sum += std::sqrt(squared);
     }
+    inliers->visible = checked;
+    if (visibility_ != nullptr &&
+        static_cast<double>(checked) < visibility_->min_visible_fraction * static_cast<double>(object_.size())) {
+      return false;
+    }
+    const size_t required =
+        std::max<size_t>(3, static_cast<size_t>(std::ceil(fraction * static_cast<double>(checked))));
     return inliers->object.size() >= required;
   }
 
