@@ -34,6 +34,7 @@ struct Scene {
   std::unique_ptr<DescriptorMatcher> matcher;
   std::vector<Eigen::Vector3f> points;  // primitive positions first, then the dense depth points
   cv::Mat color;                        // the frame's colours, as verification compares them
+  OrganizedScene organized;             // the depth samples with normals, for projective ICP
   SceneVisibility visibility;
 };
 
@@ -70,20 +71,6 @@ struct Verified {
   std::vector<cv::Point> surface;
   std::vector<Eigen::Vector3f> object_points;
 };
-
-// `camera` with one pixel per `stride` pixels of it: its pixel (u, v) sees along the ray of `camera`'s pixel
-// (stride u, stride v), so rendering at it equals sampling every stride-th pixel of a full render.
-PinholeCamera SampledCamera(const PinholeCamera& camera, int stride) {
-  PinholeCamera sampled = camera;
-  const double scale = 1.0 / stride;
-  sampled.fx *= scale;
-  sampled.fy *= scale;
-  sampled.cx *= scale;
-  sampled.cy *= scale;
-  sampled.width = (camera.width + stride - 1) / stride;
-  sampled.height = (camera.height + stride - 1) / stride;
-  return sampled;
-}
 
 // A pose hypothesis of a model from one of its views.
 struct Hypothesis {
@@ -211,6 +198,9 @@ class Recognizer::Impl {
     scene.color = frame.color;
     if (options_.color_blur_px > 0.0)
       cv::GaussianBlur(frame.color, scene.color, cv::Size(0, 0), options_.color_blur_px);
+    if (options_.refine && options_.projective_icp) {
+      scene.organized = MakeOrganizedScene(frame.depth, frame.camera, options_.dense_stride_px);
+    }
     scene.visibility.depth = frame.depth;
     scene.visibility.camera = frame.camera;
     return scene;
@@ -329,6 +319,12 @@ class Recognizer::Impl {
   void Refine(size_t model, const Scene& scene, const std::vector<Eigen::Vector3f>& object_points,
               Hypothesis* hypothesis) const {
     if (object_points.size() < 10) return;
+    if (options_.projective_icp) {
+      const IcpResult icp =
+          RefinePointToPlaneProjective(object_points, scene.organized, hypothesis->pose, options_.icp);
+      if (icp.success) hypothesis->pose = icp.scene_from_object;
+      return;
+    }
     Eigen::Vector3f centre = Eigen::Vector3f::Zero();
     for (const Eigen::Vector3f& point : object_points) centre += point;
     centre = hypothesis->pose.cast<float>() * (centre / static_cast<float>(object_points.size()));
@@ -365,7 +361,7 @@ class Recognizer::Impl {
     const LibraryModel& library_model = library_.models()[model];
     const RgbdFrame& frame = *scene.frame;
     const int stride = options_.dense_stride_px;
-    const PinholeCamera camera = SampledCamera(frame.camera, stride);
+    const PinholeCamera camera = frame.camera.Sampled(stride);
     const RenderResult rendered = renderer_.Render(meshes_[model], camera, hypothesis.pose);
     cv::Mat model_color = rendered.color;
     if (options_.color_blur_px > 0.0) {

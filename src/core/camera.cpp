@@ -61,6 +61,19 @@ bool PinholeCamera::Contains(const Eigen::Vector2d& pixel) const {
   return pixel.x() >= -0.5 && pixel.y() >= -0.5 && pixel.x() < width - 0.5 && pixel.y() < height - 0.5;
 }
 
+PinholeCamera PinholeCamera::Sampled(int stride) const {
+  if (stride < 1) ThrowInputError("camera", "stride", "at least 1", std::to_string(stride));
+  PinholeCamera sampled = *this;
+  const double scale = 1.0 / stride;
+  sampled.fx *= scale;
+  sampled.fy *= scale;
+  sampled.cx *= scale;
+  sampled.cy *= scale;
+  sampled.width = (width + stride - 1) / stride;
+  sampled.height = (height + stride - 1) / stride;
+  return sampled;
+}
+
 CameraFit FitPinholeCamera(const cv::Mat& organized_points, const std::string& source) {
   if (organized_points.type() != CV_32FC3) {
     ThrowInputError(source, "points", "an organized CV_32FC3 cloud");

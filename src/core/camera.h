@@ -32,6 +32,10 @@ struct PinholeCamera {
 
   /// True when `pixel` lies inside the image (pixel centres 0 .. width-1, 0 .. height-1, ±0.5).
   bool Contains(const Eigen::Vector2d& pixel) const;
+
+  /// The camera of every `stride`-th pixel: its pixel (u, v) sees along the ray of this camera's pixel
+  /// (stride u, stride v), so an image made for it equals every stride-th pixel of one made for this camera.
+  PinholeCamera Sampled(int stride) const;
 };
 
 /// Result of fitting a pinhole camera to an organized point cloud.

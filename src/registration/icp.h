@@ -3,6 +3,9 @@
 #include <vector>
 
 #include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
+#include "core/camera.h"
 
 namespace ecv {
 
@@ -29,5 +32,28 @@ struct IcpResult {
 IcpResult RefinePointToPlane(const std::vector<Eigen::Vector3f>& object_points,
                              const std::vector<Eigen::Vector3f>& scene_points, const Eigen::Isometry3d& initial,
                              const IcpOptions& options = {});
+
+/// A depth image prepared as the target of projective ICP: the camera-frame point and unit normal of every
+/// `stride`-th pixel.
+struct OrganizedScene {
+  PinholeCamera camera;  ///< of the samples (PinholeCamera::Sampled)
+  cv::Mat points;        ///< CV_32FC3, metres; (0, 0, 0) where the depth is missing
+  cv::Mat normals;       ///< CV_32FC3, unit; (0, 0, 0) where a neighbour is missing or across a depth gap
+};
+
+/// Samples `depth` (CV_32FC1, metres, 0 = missing; `camera`'s size) every `stride` pixels. A sample's normal is
+/// the cross product of the differences between its neighbours two samples away, left-right and up-down; it
+/// is left unknown when one of them is missing or lies more than `max_gap_m` off the sample's depth.
+OrganizedScene MakeOrganizedScene(const cv::Mat& depth, const PinholeCamera& camera, int stride,
+                                  double max_gap_m = 0.02);
+
+/// Point-to-plane ICP with projective association (as in KinectFusion): each object point is paired with the
+/// nearest of the 3x3 scene samples around the one it projects to, within max_correspondence_m. No search
+/// structure is built and normals come from the image grid, so the scene is prepared once per frame. Its
+/// basin is narrower than RefinePointToPlane's (pairs lie near the point's line of sight, not anywhere
+/// within max_correspondence_m).
+/// Same options (normal_neighbours unused) and result as RefinePointToPlane.
+IcpResult RefinePointToPlaneProjective(const std::vector<Eigen::Vector3f>& object_points, const OrganizedScene& scene,
+                                       const Eigen::Isometry3d& initial, const IcpOptions& options = {});
 
 }  // namespace ecv

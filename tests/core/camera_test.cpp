@@ -37,6 +37,21 @@ TEST(PinholeCamera, ContainsUsesPixelCentres) {
   EXPECT_FALSE(kYcbvCamera.Contains({10, -0.6}));
 }
 
+TEST(PinholeCamera, SampledPixelsSeeAlongTheRaysOfEveryStrideThPixel) {
+  for (const int stride : {1, 2, 3}) {
+    const PinholeCamera sampled = kYcbvCamera.Sampled(stride);
+    EXPECT_EQ(sampled.width, (640 + stride - 1) / stride);
+    EXPECT_EQ(sampled.height, (480 + stride - 1) / stride);
+    for (const Eigen::Vector2d& pixel : {Eigen::Vector2d(0, 0), Eigen::Vector2d(17, 101), Eigen::Vector2d(200, 159)}) {
+      const Eigen::Vector3d ray = sampled.BackProject(pixel, 1.0);
+      EXPECT_LT((kYcbvCamera.BackProject(stride * pixel, 1.0) - ray).norm(), 1e-12) << "stride " << stride;
+    }
+  }
+  // The last sample of a row is the last full pixel it covers: 639 for stride 2 (320 samples), 639 for 3.
+  EXPECT_EQ(kYcbvCamera.Sampled(3).width * 3 - 3, 639);
+  EXPECT_THROW(kYcbvCamera.Sampled(0), InputError);
+}
+
 TEST(PinholeCamera, CheckRejectsNonsense) {
   EXPECT_NO_THROW(kYcbvCamera.Check());
   PinholeCamera nan_focal = kYcbvCamera;

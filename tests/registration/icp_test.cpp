@@ -7,6 +7,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "core/error.h"
 #include "core/pose.h"
 #include "io/frame_io.h"
 #include "io/points_io.h"
@@ -81,6 +82,90 @@ TEST(Icp, RefinesTheCrackerBoxTowardsTheRealGroundTruth) {
   EXPECT_LT(TranslationDistance(result.scene_from_object, truth), 0.004);
   EXPECT_LT(RotationAngle(result.scene_from_object, truth), 3.0 * kDegree);
   EXPECT_LT(result.rmse_m, 0.004);
+}
+
+// Depth image of three faces of a 20 cm cube corner (x = 0, y = 0, z = 0 planes of the cube's frame, the
+// corner's inside towards the camera) seen at `camera_from_cube`, by ray casting.
+cv::Mat CornerDepth(const PinholeCamera& camera, const Eigen::Isometry3d& camera_from_cube) {
+  cv::Mat depth(camera.height, camera.width, CV_32FC1, cv::Scalar(0));
+  const Eigen::Isometry3d cube_from_camera = camera_from_cube.inverse();
+  for (int v = 0; v < camera.height; ++v) {
+    for (int u = 0; u < camera.width; ++u) {
+      const Eigen::Vector3d ray = cube_from_camera.linear() * camera.BackProject(Eigen::Vector2d(u, v), 1.0);
+      const Eigen::Vector3d origin = cube_from_camera.translation();
+      double nearest = 0.0;
+      for (int axis = 0; axis < 3; ++axis) {
+        if (std::abs(ray[axis]) < 1e-12) continue;
+        const double t = -origin[axis] / ray[axis];  // along the ray, per unit of camera z
+        const Eigen::Vector3d hit = origin + t * ray;
+        const bool on_face = t > 0.0 && (hit.array() >= -1e-9).all() && (hit.array() <= 0.2).all();
+        if (on_face && (nearest == 0.0 || t < nearest)) nearest = t;
+      }
+      depth.at<float>(v, u) = static_cast<float>(nearest);
+    }
+  }
+  return depth;
+}
+
+TEST(Icp, ProjectiveRecoversAPerturbedPoseOnARayCastCorner) {
+  const PinholeCamera camera{1066.778, 1067.487, 312.9869, 241.3109, 640, 480};
+  // The camera looks into the corner from the cube's diagonal, 0.7 m beyond the cube's centre.
+  const Eigen::Vector3d forward = -Eigen::Vector3d::Ones().normalized();
+  const Eigen::Vector3d right = Eigen::Vector3d(1, -1, 0).normalized();
+  Eigen::Isometry3d cube_from_camera = Eigen::Isometry3d::Identity();
+  cube_from_camera.linear() << right, forward.cross(right), forward;
+  cube_from_camera.translation() = Eigen::Vector3d::Constant(0.1) - 0.7 * forward;
+  const Eigen::Isometry3d truth = cube_from_camera.inverse();
+  const OrganizedScene scene = MakeOrganizedScene(CornerDepth(camera, truth), camera, 2);
+  // The model: the three faces, sampled every 5 mm, the ones the camera sees.
+  std::vector<Eigen::Vector3f> object;
+  for (int axis = 0; axis < 3; ++axis) {
+    for (float a = 0.01F; a < 0.19F; a += 0.005F) {
+      for (float b = 0.01F; b < 0.19F; b += 0.005F) {
+        Eigen::Vector3f p = Eigen::Vector3f::Zero();
+        p[(axis + 1) % 3] = a;
+        p[(axis + 2) % 3] = b;
+        object.push_back(p);
+      }
+    }
+  }
+  const Eigen::Isometry3d initial = Perturbation(1.5 * kDegree, 0.003) * truth;
+  const IcpResult result = RefinePointToPlaneProjective(object, scene, initial);
+  ASSERT_TRUE(result.success);
+  EXPECT_LT(TranslationDistance(result.scene_from_object, truth), 5e-4);
+  EXPECT_LT(RotationAngle(result.scene_from_object, truth), 0.1 * kDegree);
+  EXPECT_GT(result.inlier_fraction, 0.5);
+}
+
+TEST(Icp, OrganizedSceneNormalsOfARealTableAndMissingDepth) {
+  const LoadedFrame loaded = LoadYcbvFrame(test::DataPath("ycbv_subset/Example-Scenes/0001/000001"));
+  const OrganizedScene scene = MakeOrganizedScene(loaded.rgbd.depth, loaded.rgbd.camera, 2);
+  ASSERT_EQ(scene.points.cols, 320);
+  ASSERT_EQ(scene.points.rows, 240);
+  // Every sample is the depth image's pixel (2u, 2v) back-projected.
+  const cv::Vec3f& sample = scene.points.at<cv::Vec3f>(200, 100);
+  const float z = loaded.rgbd.depth.at<float>(400, 200);
+  ASSERT_GT(z, 0.0F);
+  const Eigen::Vector3d expected = loaded.rgbd.camera.BackProject(Eigen::Vector2d(200, 400), z);
+  EXPECT_NEAR(sample[0], expected.x(), 1e-6);
+  EXPECT_NEAR(sample[1], expected.y(), 1e-6);
+  EXPECT_NEAR(sample[2], expected.z(), 1e-6);
+  // Normals are unit or unknown; where the depth is missing they are unknown.
+  int unit = 0, missing_with_normal = 0;
+  for (int v = 0; v < scene.normals.rows; ++v) {
+    for (int u = 0; u < scene.normals.cols; ++u) {
+      const cv::Vec3f& n = scene.normals.at<cv::Vec3f>(v, u);
+      const double length = cv::norm(n);
+      if (length > 0.0) {
+        EXPECT_NEAR(length, 1.0, 1e-5);
+        ++unit;
+      }
+      if (scene.points.at<cv::Vec3f>(v, u)[2] == 0.0F && length > 0.0) ++missing_with_normal;
+    }
+  }
+  EXPECT_EQ(missing_with_normal, 0);
+  EXPECT_GT(unit, 320 * 240 / 2);
+  EXPECT_THROW(MakeOrganizedScene(cv::Mat(10, 10, CV_32FC1), loaded.rgbd.camera, 2), InputError);
 }
 
 TEST(Icp, TooFewPointsIsAFailedResult) {
