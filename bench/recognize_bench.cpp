@@ -78,12 +78,18 @@ void Log(const std::string& label, size_t i, size_t n, const FrameEvaluation& ev
             << Fixed(ms, 0) << " ms\n";
 }
 
+// With `track`, each frame gets the previous frame's detections of the same video as priors.
 Run RunRecognizer(const ModelLibrary& library, const RecognizerOptions& options, const std::vector<NamedFrame>& frames,
-                  const std::vector<EvalModel>& models, const std::string& label) {
+                  const std::vector<EvalModel>& models, const std::string& label, bool track = false) {
   Recognizer recognizer(library, options);
   Run run;
+  std::vector<Detection> previous;
   for (size_t i = 0; i < frames.size(); ++i) {
-    const RecognitionResult result = recognizer.Recognize(frames[i].frame.rgbd);
+    const auto video = [&](size_t k) { return frames[k].name.substr(0, frames[k].name.find('/')); };
+    if (i > 0 && video(i) != video(i - 1)) previous.clear();
+    const RecognitionResult result =
+        track ? recognizer.Recognize(frames[i].frame.rgbd, previous) : recognizer.Recognize(frames[i].frame.rgbd);
+    previous = result.detections;
     run.frames.push_back(EvaluateFrame(frames[i].name, result.detections, frames[i].frame.ground_truth, models));
     for (const auto& [stage, ms] : result.timings_ms) run.stage_ms[stage].push_back(ms);
     Log(label, i, frames.size(), run.frames.back(), result.timings_ms.at("total"));
@@ -173,7 +179,7 @@ std::string RecallTable(const Runs& runs) {
 std::string TimingTable(const Run& run) {
   std::ostringstream out;
   out << "| stage | median ms per frame |\n|---|---:|\n";
-  for (const char* stage : {"extract", "describe", "match", "ransac", "verify", "refine", "total"}) {
+  for (const char* stage : {"extract", "describe", "track", "match", "ransac", "verify", "refine", "total"}) {
     const auto found = run.stage_ms.find(stage);
     if (found != run.stage_ms.end()) out << "| " << stage << " | " << Fixed(Median(found->second), 1) << " |\n";
   }
@@ -234,8 +240,9 @@ const char* kPcl = "PCL FPFH + prerejective + ICP";
 const char* kPpf = "OpenCV PPF + ICP";
 
 // Ours with and without ICP and, with `peers`, both peers, on `frames` with the library at `db`.
+// With `track`, also ours with the previous frame's detections as priors (Recognizer::Recognize with priors).
 Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, bool peers, bool ours, bool object_pixels,
-            const PeerOptions& peer_options, std::ostringstream* notes) {
+            bool track, const PeerOptions& peer_options, std::ostringstream* notes) {
   LibraryLoadOptions load;
   load.build_matchers = false;
   const ModelLibrary library = ModelLibrary::Load(db, load);
@@ -250,6 +257,9 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, bool p
   RecognizerOptions options;
   if (ours) {
     runs.emplace_back("ECV + RANSAC + ICP", RunRecognizer(library, options, frames, models, "icp"));
+    if (track) {
+      runs.emplace_back("ECV + RANSAC + ICP, tracking", RunRecognizer(library, options, frames, models, "track", true));
+    }
     options.refine = false;
     runs.emplace_back("ECV + RANSAC (no ICP)", RunRecognizer(library, options, frames, models, "no icp"));
   }
@@ -271,8 +281,9 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, bool p
     runs.emplace_back(std::string(kPcl) + ", objects' pixels only", RunPeer(*pcl, masked, models, "pcl objects"));
     runs.emplace_back(std::string(kPpf) + ", objects' pixels only", RunPeer(*ppf, masked, models, "ppf objects"));
   }
-  const Run& pcl_run = runs[ours ? 2 : 0].second;
-  const Run& ppf_run = runs[ours ? 3 : 1].second;
+  const size_t first_peer = ours ? (track ? 3 : 2) : 0;
+  const Run& pcl_run = runs[first_peer].second;
+  const Run& ppf_run = runs[first_peer + 1].second;
   *notes << "Peers: model set-up (voxel grid, PCL normals + FPFH) " << Fixed(pcl_setup_ms, 0)
          << " ms for PCL, PPF training " << Fixed(ppf_setup_ms, 0) << " ms for OpenCV, not in the times per frame; "
          << "scene cloud " << Fixed(Median(pcl_run.stage_ms.at("scene points")), 0)
@@ -317,7 +328,7 @@ int main(int argc, char** argv) {
   using namespace ecv::bench;
   std::string db, lmo_db, results = std::string(ECV_SOURCE_DIR) + "/bench/RESULTS.md";
   int limit = 0, step = 1;
-  bool peers = false, ours = true, object_pixels = false;
+  bool peers = false, ours = true, object_pixels = false, track = false;
   PeerOptions peer_options;
   for (int i = 1; i < argc; ++i) {
     const bool has_value = i + 1 < argc;
@@ -328,6 +339,8 @@ int main(int argc, char** argv) {
       ours = false;
     } else if (std::strcmp(argv[i], "--object-pixels") == 0) {  // peers also on the objects' pixels only
       object_pixels = true;
+    } else if (std::strcmp(argv[i], "--track") == 0) {  // ours also with the previous frame's detections
+      track = true;
     } else if (has_value && std::strcmp(argv[i], "--frame-step") == 0) {
       step = std::atoi(argv[++i]);
     } else if (has_value && std::strcmp(argv[i], "--ppf-sampling") == 0) {
@@ -352,6 +365,7 @@ int main(int argc, char** argv) {
   if (db.empty()) {
     std::cerr
         << "usage: recognize_bench --db LIB.sqlite [--lmo-db LMO.sqlite] [--peers | --peers-only] [--object-pixels]\n"
+           "         [--track]\n"
            "         [--results FILE] [--frames N] [--frame-step S] [--ppf-sampling R] [--ppf-scene-distance R]\n"
            "         [--min-inlier-fraction F]\n"
            "  (build the libraries with scripts/build_ycbv_library LIB.sqlite --views 40 --distance 0.9 and\n"
@@ -362,17 +376,22 @@ int main(int argc, char** argv) {
     peer_options.Check();
     std::ostringstream markdown, notes;
     const std::vector<NamedFrame> frames = YcbvFrames(ECV_DATA_DIR, limit, step);
-    const Runs runs = RunAll(db, frames, peers, ours, object_pixels, peer_options, &notes);
+    const Runs runs = RunAll(db, frames, peers, ours, object_pixels, track, peer_options, &notes);
     markdown << notes.str() << frames.size()
              << " YCB-Video frames (videos 0000-0002). Correct = ADD < 0.1 x diameter (ADD-S for symmetric models); "
                 "a false positive is a detection of a model not in the frame or a wrong pose.\n\n"
              << RecallTable(runs);
     if (ours)
       markdown << "\nTime per frame, whole library (ECV + RANSAC + ICP):\n\n" << TimingTable(runs.front().second);
+    if (ours && track) {
+      markdown << "\nThe same with tracking (each frame gets the previous frame's detections of its video as priors; "
+                  "the first frame of each video has none):\n\n"
+               << TimingTable(runs[1].second);
+    }
     if (!lmo_db.empty()) {
       std::ostringstream lmo_notes;
       const Runs lmo_runs =
-          RunAll(lmo_db, LmoFrames(ECV_DATA_DIR), peers, ours, object_pixels, peer_options, &lmo_notes);
+          RunAll(lmo_db, LmoFrames(ECV_DATA_DIR), peers, ours, object_pixels, false, peer_options, &lmo_notes);
       markdown << "\nLinemod-Occluded, scene 000002 image 3 (Kinect v1, 8 vertex-coloured models, eggbox and glue "
                   "judged by ADD-S). "
                << lmo_notes.str() << "\n\n"

@@ -31,6 +31,7 @@ struct RecognizeArgs {
   std::string out_bop;
   int scene_id = -1, image_id = -1;
   std::string overlay;
+  bool track = false;
 };
 
 // BOP object id of a model: the number in "obj_000005", or the YCB-Video class index of "003_cracker_box".
@@ -107,6 +108,7 @@ int RunRecognize(const RecognizeArgs& args) {
   if (!args.sequence.empty() && (!args.frame.positional.empty() || args.frame.color_path.size() > 0)) {
     ThrowInputError("recognize", "--sequence", "either a sequence or one frame, not both");
   }
+  if (args.track && args.sequence.empty()) ThrowInputError("recognize", "--track", "a --sequence to track along");
   if (!args.sequence.empty() && !args.overlay.empty()) {
     ThrowInputError("recognize", "--overlay", "one frame (not with --sequence)");
   }
@@ -141,13 +143,16 @@ int RunRecognize(const RecognizeArgs& args) {
   csv << "scene_id,im_id,obj_id,score,R,t,time\n";
   int failed = 0;
   double total_ms = 0.0;
+  std::vector<Detection> previous;  // the last frame's detections, the priors when tracking
   for (size_t i = 0; i < frames.size(); ++i) {
     FrameSpec spec;
     spec.positional = frames[i];
     try {
       const LoadedFrame loaded = LoadFrame(spec);
       const std::pair<int, int> ids = args.out_bop.empty() ? std::pair{-1, -1} : BopIds(frames[i], -1, -1);
-      const RecognitionResult result = recognizer.Recognize(loaded.rgbd);
+      const RecognitionResult result =
+          args.track ? recognizer.Recognize(loaded.rgbd, previous) : recognizer.Recognize(loaded.rgbd);
+      previous = result.detections;
       total_ms += result.timings_ms.at("total");
       std::cout << "[" << i + 1 << "/" << frames.size() << "] ";
       PrintDetections(loaded, result);
@@ -157,6 +162,7 @@ int RunRecognize(const RecognizeArgs& args) {
       if (!args.out_bop.empty()) AppendBopRows(csv, ids.first, ids.second, result);
     } catch (const InputError& error) {
       ++failed;
+      previous.clear();
       std::cerr << "recognize: frame " << frames[i] << " skipped: " << error.what() << '\n';
       lines << nlohmann::json{{"frame", frames[i]}, {"error", error.what()}}.dump() << '\n';
     }
@@ -204,6 +210,9 @@ CommandAction SetupRecognizeCommand(CLI::App& command) {
       ->capture_default_str();
   command.add_flag(
       "--no-icp", [&options = args->options](int64_t) { options.refine = false; }, "Skip the ICP refinement");
+  command.add_flag("--track", args->track,
+                   "With --sequence: try each object first at its pose in the previous frame (refined and verified);\n"
+                   "objects tracked so skip view ranking and RANSAC");
   command.add_flag("--fast-icp", options.projective_icp,
                    "ICP pairs points along the camera's rays (7x faster refinement, finds fewer objects)");
   command.footer(

@@ -142,21 +142,33 @@ class Recognizer::Impl {
     }
   }
 
-  RecognitionResult Recognize(const RgbdFrame& frame) {
+  RecognitionResult Recognize(const RgbdFrame& frame, const std::vector<Detection>& priors) {
     frame.Check();
     const Clock::time_point start = Clock::now();
     RecognitionResult result;
     const Scene scene = PrepareScene(frame, &result);
-    Clock::time_point stage = Clock::now();
-    const std::vector<std::vector<ViewCandidate>> ranked = RankAllViews(scene);
-    result.timings_ms["match"] += MillisecondsSince(stage);
     std::vector<Verified> candidates;  // each model's best detection
-    for (size_t m = 0; m < library_.models().size(); ++m) {
-      std::optional<Verified> best = BestDetection(m, ranked[m], scene, &result.timings_ms);
-      if (best && best->detection.score >= options_.min_score &&
-          best->detection.visible_fraction >= options_.min_visible_fraction) {
-        candidates.push_back(std::move(*best));
+    std::vector<bool> done(library_.models().size(), false);
+    Clock::time_point stage = Clock::now();
+    for (const Detection& prior : priors) {
+      const auto model = std::find_if(records_.begin(), records_.end(),
+                                      [&](const ModelRecord& record) { return record.name == prior.model; });
+      const size_t m = static_cast<size_t>(model - records_.begin());
+      if (model == records_.end() || done[m]) continue;
+      std::optional<Verified> tracked = Track(m, prior, scene);
+      if (tracked && Accepted(tracked->detection)) {
+        candidates.push_back(std::move(*tracked));
+        done[m] = true;
       }
+    }
+    if (!priors.empty()) result.timings_ms["track"] = MillisecondsSince(stage);
+    stage = Clock::now();
+    const std::vector<std::vector<ViewCandidate>> ranked = RankAllViews(scene, done);
+    result.timings_ms["match"] += MillisecondsSince(stage);
+    for (size_t m = 0; m < library_.models().size(); ++m) {
+      if (done[m]) continue;
+      std::optional<Verified> best = BestDetection(m, ranked[m], scene, &result.timings_ms);
+      if (best && Accepted(best->detection)) candidates.push_back(std::move(*best));
     }
     stage = Clock::now();
     result.detections = SuppressOverlaps(frame.depth.size(), std::move(candidates));
@@ -166,6 +178,25 @@ class Recognizer::Impl {
   }
 
  private:
+  bool Accepted(const Detection& detection) const {
+    return detection.score >= options_.min_score && detection.visible_fraction >= options_.min_visible_fraction;
+  }
+
+  // A prior's model at the prior's pose, refined by ICP when that raises the score (its RANSAC fields stay 0).
+  std::optional<Verified> Track(size_t model, const Detection& prior, const Scene& scene) {
+    Hypothesis hypothesis;
+    hypothesis.view = prior.view;
+    hypothesis.pose = prior.camera_from_object;
+    Verified best = Verify(model, scene, hypothesis);
+    if (options_.refine) {
+      Refine(model, scene, best.object_points, &hypothesis);
+      Verified refined = Verify(model, scene, hypothesis);
+      if (refined.detection.score >= best.detection.score) best = std::move(refined);
+    }
+    best.detection.tracked = true;
+    return best;
+  }
+
   Scene PrepareScene(const RgbdFrame& frame, RecognitionResult* result) const {
     Scene scene;
     scene.frame = &frame;
@@ -195,9 +226,12 @@ class Recognizer::Impl {
         if (z > 0.0F) scene.points.push_back(frame.camera.BackProject({u, v}, z).cast<float>());
       }
     }
-    scene.color = frame.color;
-    if (options_.color_blur_px > 0.0)
+    // Into a new image: scene.color must not share the frame's pixels, or the blur would change the caller's frame.
+    if (options_.color_blur_px > 0.0) {
       cv::GaussianBlur(frame.color, scene.color, cv::Size(0, 0), options_.color_blur_px);
+    } else {
+      scene.color = frame.color;
+    }
     if (options_.refine && options_.projective_icp) {
       scene.organized = MakeOrganizedScene(frame.depth, frame.camera, options_.dense_stride_px);
     }
@@ -240,13 +274,15 @@ class Recognizer::Impl {
     return best;
   }
 
-  // RankViews of every model, the models shared out over RansacOptions::threads workers (each model's
-  // ranking depends on nothing else, so the result does not depend on the count).
-  std::vector<std::vector<ViewCandidate>> RankAllViews(const Scene& scene) const {
+  // RankViews of every model but the skipped ones, the models shared out over RansacOptions::threads workers (each
+  // model's ranking depends on nothing else, so the result does not depend on the count).
+  std::vector<std::vector<ViewCandidate>> RankAllViews(const Scene& scene, const std::vector<bool>& skip) const {
     std::vector<std::vector<ViewCandidate>> ranked(records_.size());
     std::atomic<size_t> next{0};
     auto work = [&] {
-      for (size_t m = next++; m < records_.size(); m = next++) ranked[m] = RankViews(m, scene);
+      for (size_t m = next++; m < records_.size(); m = next++) {
+        if (!skip[m]) ranked[m] = RankViews(m, scene);
+      }
     };
     std::vector<std::thread> workers;
     const size_t threads = std::min(records_.size(), static_cast<size_t>(options_.ransac.threads));
@@ -363,9 +399,11 @@ class Recognizer::Impl {
     const int stride = options_.dense_stride_px;
     const PinholeCamera camera = frame.camera.Sampled(stride);
     const RenderResult rendered = renderer_.Render(meshes_[model], camera, hypothesis.pose);
-    cv::Mat model_color = rendered.color;
+    cv::Mat model_color;
     if (options_.color_blur_px > 0.0) {
       cv::GaussianBlur(rendered.color, model_color, cv::Size(0, 0), options_.color_blur_px / stride);
+    } else {
+      model_color = rendered.color;
     }
     const Eigen::Isometry3f object_from_camera = hypothesis.pose.inverse().cast<float>();
     Eigen::Matrix3f to_scene = Eigen::Matrix3f::Identity();
@@ -457,7 +495,11 @@ Recognizer::Recognizer(const ModelLibrary& library, const RecognizerOptions& opt
 Recognizer::~Recognizer() = default;
 
 RecognitionResult Recognizer::Recognize(const RgbdFrame& frame) {
-  return impl_->Recognize(frame);
+  return impl_->Recognize(frame, {});
+}
+
+RecognitionResult Recognizer::Recognize(const RgbdFrame& frame, const std::vector<Detection>& priors) {
+  return impl_->Recognize(frame, priors);
 }
 
 cv::Mat Recognizer::DrawDetections(const RgbdFrame& frame, const std::vector<Detection>& detections) {
@@ -475,7 +517,8 @@ nlohmann::json RecognitionToJson(const RecognitionResult& result) {
                           {"view", d.view},
                           {"depth_agreement", d.depth_agreement},
                           {"color_agreement", d.color_agreement},
-                          {"visible_fraction", d.visible_fraction}});
+                          {"visible_fraction", d.visible_fraction},
+                          {"tracked", d.tracked}});
   }
   return {{"detections", detections}, {"timings_ms", result.timings_ms}, {"scene_primitives", result.scene_primitives}};
 }

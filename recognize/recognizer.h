@@ -88,12 +88,14 @@ struct Detection {
   double depth_agreement = 0.0;   ///< share of the visible rendered pixels on the scene surface
   double color_agreement = 0.0;   ///< correlation of the rendered colours with the scene's on those, 0..1
   double visible_fraction = 0.0;  ///< share of the rendered pixels the scene can show (not hidden, with depth)
+  bool tracked = false;           ///< found from a prior (the previous frame's pose), without RANSAC
 };
 
 /// Detections of one frame and where the time went.
 struct RecognitionResult {
-  std::vector<Detection> detections;         ///< best score first, at most one per model, overlaps suppressed
-  std::map<std::string, double> timings_ms;  ///< per stage: extract, describe, match, ransac, refine, verify, total
+  std::vector<Detection> detections;  ///< best score first, at most one per model, overlaps suppressed
+  std::map<std::string, double>
+      timings_ms;  ///< per stage: extract, describe, track, match, ransac, refine, verify, total
   int scene_primitives = 0;
 };
 
@@ -115,6 +117,11 @@ class Recognizer {
   Recognizer& operator=(const Recognizer&) = delete;
 
   RecognitionResult Recognize(const RgbdFrame& frame);
+
+  /// Tracking, for frames of a stream (beyond the paper): each prior (a detection of the previous frame) is
+  /// first tried at its pose, refined by ICP and verified as any detection; when it passes, its model skips
+  /// view ranking and RANSAC in this frame. Models without a prior, or whose prior fails, are recognised.
+  RecognitionResult Recognize(const RgbdFrame& frame, const std::vector<Detection>& priors);
 
   /// `frame`'s colour image with each detected model rendered at its pose in red, outlined, with its name.
   cv::Mat DrawDetections(const RgbdFrame& frame, const std::vector<Detection>& detections);

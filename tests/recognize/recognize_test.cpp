@@ -7,6 +7,7 @@
 #include "io/pose_io.h"
 #include "modeldb/model_library.h"
 #include "recognize/evaluation.h"
+#include "recognize/recognizer.h"
 #include "support/test_data.h"
 
 namespace ecv {
@@ -77,6 +78,22 @@ TEST_F(RecognizeEndToEnd, SameSeedSameDetections) {
     outputs[i] = ReadJsonFile(json).at("detections").dump();
   }
   EXPECT_EQ(outputs[0], outputs[1]) << "one and two threads, the same seed";
+}
+
+TEST_F(RecognizeEndToEnd, TheSameFrameTwiceGivesTheSameDetectionsAndTheFrameIsLeftAlone) {
+  LibraryLoadOptions load;
+  load.build_matchers = false;
+  const ModelLibrary library = ModelLibrary::Load(library_, load);
+  const LoadedFrame frame = LoadYcbvFrame(Frame());
+  const cv::Mat color = frame.rgbd.color.clone(), depth = frame.rgbd.depth.clone();
+  Recognizer recognizer(library);
+  const nlohmann::json first = RecognitionToJson(recognizer.Recognize(frame.rgbd)).at("detections");
+  // The colour blur of verification once wrote into the caller's image: a second call saw a blurrier frame.
+  EXPECT_EQ(cv::norm(frame.rgbd.color, color, cv::NORM_L1), 0.0);
+  EXPECT_EQ(cv::norm(frame.rgbd.depth, depth, cv::NORM_L1), 0.0);
+  const nlohmann::json second = RecognitionToJson(recognizer.Recognize(frame.rgbd)).at("detections");
+  EXPECT_FALSE(first.empty());
+  EXPECT_EQ(first.dump(), second.dump());
 }
 
 TEST_F(RecognizeEndToEnd, BadInputIsReported) {

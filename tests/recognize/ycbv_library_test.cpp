@@ -107,6 +107,29 @@ TEST_F(YcbvLibrary, SameSeedSameOutputWithOneOrTwoThreads) {
   for (size_t i = 0; i < one.size(); ++i) EXPECT_EQ(one[i].at("detections"), two[i].at("detections")) << i;
 }
 
+TEST_F(YcbvLibrary, TracksTheThreeObjectsOfVideo0001FromFrameToFrame) {
+  const std::string scenes = test::DataPath("ycbv_subset/Example-Scenes/0001/");
+  const std::vector<std::string> frames = {scenes + "000001", scenes + "000003", scenes + "000005", scenes + "000007"};
+  const std::vector<nlohmann::json> lines = Recognize("track", "--track", frames);
+  ASSERT_EQ(lines.size(), frames.size());
+  LibraryLoadOptions load;
+  load.build_matchers = false;
+  const ModelLibrary library = ModelLibrary::Load(library_, load);
+  std::vector<EvalModel> models;
+  for (const LibraryModel& model : library.models()) models.push_back(EvalModelFromRecord(model.record));
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const FrameEvaluation evaluation = EvaluateFrame(frames[i], DetectionsFromJson(lines[i], frames[i]),
+                                                     LoadYcbvFrame(frames[i]).ground_truth, models);
+    ASSERT_EQ(evaluation.objects.size(), 3U);  // cracker box, sugar box, mustard bottle
+    for (const ObjectEvaluation& object : evaluation.objects) EXPECT_TRUE(object.correct) << frames[i] << object.model;
+    EXPECT_EQ(evaluation.false_positives, 0) << frames[i];
+    // The first frame has no priors; later ones keep all three at their previous poses.
+    for (const nlohmann::json& detection : lines[i].at("detections")) {
+      EXPECT_EQ(detection.at("tracked").get<bool>(), i > 0) << frames[i] << detection.dump();
+    }
+  }
+}
+
 TEST_F(YcbvLibrary, BrokenFrameInSequenceIsReportedAndTheOthersAreProcessed) {
   const std::string list = directory_->File("broken.txt"), out = directory_->File("broken.jsonl");
   const std::string missing = directory_->File("no_such_video/000001");
