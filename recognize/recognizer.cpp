@@ -146,7 +146,7 @@ class Recognizer::Impl {
     frame.Check();
     const Clock::time_point start = Clock::now();
     RecognitionResult result;
-    const Scene scene = PrepareScene(frame, &result);
+    Scene scene = PrepareScene(frame);
     std::vector<Verified> candidates;  // each model's best detection
     std::vector<bool> done(library_.models().size(), false);
     Clock::time_point stage = Clock::now();
@@ -162,6 +162,7 @@ class Recognizer::Impl {
       }
     }
     if (!priors.empty()) result.timings_ms["track"] = MillisecondsSince(stage);
+    if (std::count(done.begin(), done.end(), false) > 0) DescribeScene(&scene, &result);  // none when all tracked
     stage = Clock::now();
     const std::vector<std::vector<ViewCandidate>> ranked = RankAllViews(scene, done);
     result.timings_ms["match"] += MillisecondsSince(stage);
@@ -197,28 +198,10 @@ class Recognizer::Impl {
     return best;
   }
 
-  Scene PrepareScene(const RgbdFrame& frame, RecognitionResult* result) const {
+  // What every model needs of the frame: the dense points, colours and visibility (no primitives yet).
+  Scene PrepareScene(const RgbdFrame& frame) const {
     Scene scene;
     scene.frame = &frame;
-    Clock::time_point stage = Clock::now();
-    const FeatureSettings& settings = library_.feature_settings();
-    scene.primitives = ExtractPrimitives(frame, settings.ecv).primitives;
-    result->scene_primitives = static_cast<int>(scene.primitives.size());
-    result->timings_ms["extract"] = MillisecondsSince(stage);
-
-    stage = Clock::now();
-    DescriptorOptions describe = settings.descriptor;
-    if (options_.scene_max_neighbours > 0 &&
-        (describe.max_neighbours == 0 || describe.max_neighbours > options_.scene_max_neighbours)) {
-      describe.max_neighbours = options_.scene_max_neighbours;
-    }
-    scene.descriptors = ComputeDescriptors(scene.primitives, describe);
-    if (scene.descriptors.values.rows > 0) {
-      scene.matcher = std::make_unique<DescriptorMatcher>(scene.primitives, scene.descriptors, options_.match);
-    }
-    result->timings_ms["describe"] = MillisecondsSince(stage);
-
-    scene.points = PrimitivePositions(scene.primitives);
     const int stride = options_.dense_stride_px;
     for (int v = 0; v < frame.depth.rows; v += stride) {
       for (int u = 0; u < frame.depth.cols; u += stride) {
@@ -238,6 +221,31 @@ class Recognizer::Impl {
     scene.visibility.depth = frame.depth;
     scene.visibility.camera = frame.camera;
     return scene;
+  }
+
+  // The frame's primitives (put before the dense points in scene->points, so that a primitive's index is its
+  // point's), their descriptors and a matcher over them: what view ranking and RANSAC need.
+  void DescribeScene(Scene* scene, RecognitionResult* result) const {
+    const RgbdFrame& frame = *scene->frame;
+    Clock::time_point stage = Clock::now();
+    const FeatureSettings& settings = library_.feature_settings();
+    scene->primitives = ExtractPrimitives(frame, settings.ecv).primitives;
+    result->scene_primitives = static_cast<int>(scene->primitives.size());
+    const std::vector<Eigen::Vector3f> positions = PrimitivePositions(scene->primitives);
+    scene->points.insert(scene->points.begin(), positions.begin(), positions.end());
+    result->timings_ms["extract"] = MillisecondsSince(stage);
+
+    stage = Clock::now();
+    DescriptorOptions describe = settings.descriptor;
+    if (options_.scene_max_neighbours > 0 &&
+        (describe.max_neighbours == 0 || describe.max_neighbours > options_.scene_max_neighbours)) {
+      describe.max_neighbours = options_.scene_max_neighbours;
+    }
+    scene->descriptors = ComputeDescriptors(scene->primitives, describe);
+    if (scene->descriptors.values.rows > 0) {
+      scene->matcher = std::make_unique<DescriptorMatcher>(scene->primitives, scene->descriptors, options_.match);
+    }
+    result->timings_ms["describe"] = MillisecondsSince(stage);
   }
 
   // The model's best pose over its ranked views: RANSAC per view, each pose verified as it is, the best one
