@@ -37,6 +37,7 @@ constexpr double kTrueMatch = 0.01;  // metres
 struct PairScore {
   double score = 0.0, random = 0.0, ceiling = 0.0;
   int hypotheses = 0;
+  double describe_ms = 0.0;  // ECV only: both views' descriptors
 };
 
 // Expected score of matching at random and the ceiling (share with any true partner within 1 cm) of
@@ -113,9 +114,11 @@ PairPrimitives Extract(const ViewPair& pair, const EcvOptions& options) {
 // ECV context descriptors matched with ecvpose's own matcher.
 PairScore ScoreEcv(const ViewPair& pair, const PairPrimitives& primitives, const DescriptorOptions& descriptor,
                    const MatchOptions& matching) {
+  const Clock::time_point start = Clock::now();
   const Descriptors query = ComputeDescriptors(primitives.query, descriptor);
   const Descriptors train = ComputeDescriptors(primitives.train, descriptor);
   PairScore result;
+  result.describe_ms = MillisecondsSince(start);
   if (query.primitive.empty() || train.primitive.empty()) return result;
   const DescriptorMatcher matcher(primitives.train, train, matching);
   const CorrespondenceScore score = ScoreCorrespondences(
@@ -138,20 +141,38 @@ std::vector<Eigen::Vector3f> Positions(const std::vector<Primitive>& primitives)
 
 using Method = std::function<PairScore(const ViewPair&, const PairPrimitives&)>;
 
+// Issue 5's descriptor variant: source pairs {s, n} in four radial shells over 4.5 cm (bench/RESULTS.md).
+DescriptorOptions SourceShellOptions() {
+  DescriptorOptions options;
+  options.pairs = DescriptorPairs::kSource;
+  options.shells = 4;
+  options.radius_m = 0.045;
+  return options;
+}
+
 std::vector<std::pair<std::string, Method>> Methods() {
   std::vector<std::pair<std::string, Method>> methods;
   methods.emplace_back("ECV context",
                        [](const ViewPair& pair, const PairPrimitives& p) { return ScoreEcv(pair, p, {}, {}); });
-  for (const PclDescriptor descriptor :
-       {PclDescriptor::kFpfh, PclDescriptor::kShot, PclDescriptor::kShotColor, PclDescriptor::kSpinImage}) {
+  methods.emplace_back("ECV source pairs, 4 shells, r 4.5 cm", [](const ViewPair& pair, const PairPrimitives& p) {
+    return ScoreEcv(pair, p, SourceShellOptions(), {});
+  });
+  auto add_pcl = [&](PclDescriptor descriptor, double radius_m, const std::string& suffix) {
     methods.emplace_back(
-        std::string(ToString(descriptor)) + " @ECV", [descriptor](const ViewPair& pair, const PairPrimitives& p) {
+        std::string(ToString(descriptor)) + " @ECV" + suffix,
+        [descriptor, radius_m](const ViewPair& pair, const PairPrimitives& p) {
           return ScoreKeypoints(
-              ComputePclDescriptors(pair.query.rgbd, pair.query.mask, Positions(p.query), descriptor, 0.025),
-              ComputePclDescriptors(pair.train.rgbd, pair.train.mask, Positions(p.train), descriptor, 0.025),
+              ComputePclDescriptors(pair.query.rgbd, pair.query.mask, Positions(p.query), descriptor, radius_m),
+              ComputePclDescriptors(pair.train.rgbd, pair.train.mask, Positions(p.train), descriptor, radius_m),
               pair.TrainFromQuery());
         });
+  };
+  for (const PclDescriptor descriptor :
+       {PclDescriptor::kFpfh, PclDescriptor::kShot, PclDescriptor::kShotColor, PclDescriptor::kSpinImage}) {
+    add_pcl(descriptor, 0.025, "");
   }
+  for (const PclDescriptor descriptor : {PclDescriptor::kFpfh, PclDescriptor::kShot, PclDescriptor::kShotColor})
+    add_pcl(descriptor, 0.045, " r 4.5 cm");
   for (const ImageDescriptor descriptor : {ImageDescriptor::kSift, ImageDescriptor::kOrb}) {
     methods.emplace_back(std::string(ToString(descriptor)) + " @ECV",
                          [descriptor](const ViewPair& pair, const PairPrimitives& p) {
@@ -324,6 +345,45 @@ std::vector<Variant> Variants() {
   add("max edge variance 0.15", [](Variant& v) { v.extraction.max_edge_variance = 0.15; });
   add("max edge variance 0.35", [](Variant& v) { v.extraction.max_edge_variance = 0.35; });
   add("no edge NMS", [](Variant& v) { v.extraction.edge_nms = false; });
+  // Issue 5's descriptor variants: source pairs (O(k)), closeness weights, radial shells, and appearance
+  // (RGB log ratios; the paper's future work, monogenic magnitude and orientation).
+  auto source = [&](const std::string& name, int shells, double radius_m, const std::function<void(Variant&)>& more) {
+    add("source pairs" + name, [&](Variant& v) {
+      v.descriptor.pairs = DescriptorPairs::kSource;
+      v.descriptor.shells = shells;
+      v.descriptor.radius_m = radius_m;
+      more(v);
+    });
+  };
+  const auto nothing = [](Variant&) {};
+  const auto log_ratios = [](Variant& v) { v.descriptor.appearance = DescriptorAppearance::kRgbLogRatio; };
+  const auto monogenic = [](Variant& v) { v.descriptor.appearance = DescriptorAppearance::kMonogenic; };
+  add("closeness weight 0.5", [](Variant& v) { v.descriptor.closeness_weight = 0.5; });
+  add("closeness weight 1", [](Variant& v) { v.descriptor.closeness_weight = 1.0; });
+  add("RGB log ratios", log_ratios);
+  add("monogenic appearance", monogenic);
+  add("2 shells (all pairs)", [](Variant& v) { v.descriptor.shells = 2; });
+  source(" {s, n}", 1, 0.025, nothing);
+  source(", closeness weight 0.5", 1, 0.025, [](Variant& v) { v.descriptor.closeness_weight = 0.5; });
+  source(", RGB log ratios", 1, 0.025, log_ratios);
+  source(", monogenic appearance", 1, 0.025, monogenic);
+  source(", radius 0.035 m", 1, 0.035, nothing);
+  for (const int shells : {2, 4}) {
+    for (const double radius : {0.025, 0.035, 0.045, 0.055, 0.065}) {
+      source(", " + std::to_string(shells) + " shells, radius " + Fixed(radius, 3) + " m", shells, radius, nothing);
+    }
+  }
+  source(", 2 shells, radius 0.035 m, RGB log ratios", 2, 0.035, log_ratios);
+  source(", 2 shells, radius 0.035 m, monogenic", 2, 0.035, monogenic);
+  source(", 2 shells, radius 0.035 m, hard bins", 2, 0.035, [](Variant& v) { v.descriptor.soft_binning = false; });
+  source(", 2 shells, radius 0.035 m, closeness weight 0.5", 2, 0.035,
+         [](Variant& v) { v.descriptor.closeness_weight = 0.5; });
+  source(", 4 shells, radius 0.045 m, RGB log ratios", 4, 0.045, log_ratios);
+  source(", 4 shells, radius 0.045 m, monogenic", 4, 0.045, monogenic);
+  source(", 4 shells, radius 0.045 m, grey-world colour balance", 4, 0.045,
+         [](Variant& v) { v.descriptor.balance_colors = true; });
+  source(", 4 shells, radius 0.045 m, mixed matching", 4, 0.045,
+         [](Variant& v) { v.matching.structure_specific = false; });
   return variants;
 }
 
@@ -344,32 +404,49 @@ bool SameExtraction(const EcvOptions& a, const EcvOptions& b) {
          a.min_magnitude == b.min_magnitude && a.max_edge_variance == b.max_edge_variance && a.edge_nms == b.edge_nms;
 }
 
-// Mean ECV score of each variant per set, on the tuning pairs (videos 0000, 0001) and the held-out ones.
+// The primitives of a dense close-up frame (YCB-Video 0000/000001, whole image) for the descriptor time.
+std::vector<Primitive> DenseFramePrimitives(const EcvOptions& options) {
+  return ExtractPrimitives(LoadYcbvFrame(std::string(ECV_DATA_DIR) + "/ycbv_subset/Example-Scenes/0000/000001").rgbd,
+                           options)
+      .primitives;
+}
+
+// Mean ECV score of each variant per set, on the tuning pairs (videos 0000, 0001) and the held-out ones,
+// with the descriptor time per view of the pairs and of the dense frame.
 std::string AblationTable(const std::vector<ViewPair>& pairs, const std::vector<PairPrimitives>& default_primitives,
                           const std::string& filter) {
-  const std::vector<std::string> sets = {"recognition", "hard", "easy"};
+  const std::vector<Primitive> dense = DenseFramePrimitives({});
   std::string table =
       "### Ablations of the ECV context descriptor (mean score %, tuning = videos 0000 and 0001, held out = 0002)\n\n"
-      "| variant | recognition tuning | recognition held out | hard (held out) | easy tuning | easy held out |\n"
-      "|---|---:|---:|---:|---:|---:|\n";
+      "describe ms/view: mean over the pairs' views; dense frame: YCB-Video 0000/000001, whole image (" +
+      std::to_string(dense.size()) +
+      " primitives with the default extraction).\n\n"
+      "| variant | recognition tuning | recognition held out | hard (held out) | easy tuning | easy held out | "
+      "describe ms/view | describe ms, dense frame |\n"
+      "|---|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const Variant& variant : Variants()) {
     if (!MatchesFilter(variant.name, filter)) continue;
     std::map<std::string, std::pair<double, int>> sums;  // key: set + tuning/held-out
+    const bool same_extraction = SameExtraction(variant.extraction, EcvOptions{});
+    double describe_ms = 0.0;
     for (size_t i = 0; i < pairs.size(); ++i) {
-      const PairPrimitives primitives = SameExtraction(variant.extraction, EcvOptions{})
-                                            ? default_primitives[i]
-                                            : Extract(pairs[i], variant.extraction);
-      const double score = ScoreEcv(pairs[i], primitives, variant.descriptor, variant.matching).score;
+      const PairPrimitives primitives = same_extraction ? default_primitives[i] : Extract(pairs[i], variant.extraction);
+      const PairScore score = ScoreEcv(pairs[i], primitives, variant.descriptor, variant.matching);
+      describe_ms += score.describe_ms;
       auto& [sum, count] = sums[pairs[i].set + (pairs[i].held_out ? "/held" : "/tune")];
-      sum += score;
+      sum += score.score;
       ++count;
     }
+    const Clock::time_point start = Clock::now();
+    ComputeDescriptors(same_extraction ? dense : DenseFramePrimitives(variant.extraction), variant.descriptor);
+    const double dense_ms = MillisecondsSince(start);
     auto mean = [&](const std::string& key) {
       const auto found = sums.find(key);
       return found == sums.end() ? std::string("") : Percent(found->second.first / found->second.second);
     };
     table += "| " + variant.name + " | " + mean("recognition/tune") + " | " + mean("recognition/held") + " | " +
-             mean("hard/held") + " | " + mean("easy/tune") + " | " + mean("easy/held") + " |\n";
+             mean("hard/held") + " | " + mean("easy/tune") + " | " + mean("easy/held") + " | " +
+             Fixed(describe_ms / (2.0 * static_cast<double>(pairs.size())), 1) + " | " + Fixed(dense_ms, 0) + " |\n";
     std::cerr << '.' << std::flush;
   }
   return table + "\n";
@@ -414,6 +491,8 @@ int main(int argc, char** argv) {
   std::cerr << '\n';
   if (ablations_only) {
     std::cout << ablations;
+    Report(results, "Ablations of the ECV context descriptor (discriminative_bench)", CommandLine(argc, argv),
+           ablations);
     return 0;
   }
   std::string report =

@@ -32,6 +32,10 @@ void VisitFields(Settings& settings, Visit visit) {
   visit("descriptor", "use_color", d.use_color);
   visit("descriptor", "balance_colors", d.balance_colors);
   visit("descriptor", "hellinger", d.hellinger);
+  visit("descriptor", "pairs", d.pairs);            // DescriptorPairs as its integer value
+  visit("descriptor", "appearance", d.appearance);  // DescriptorAppearance as its integer value
+  visit("descriptor", "closeness_weight", d.closeness_weight);
+  visit("descriptor", "shells", d.shells);
 }
 
 nlohmann::ordered_json ToJson(const FeatureSettings& settings) {

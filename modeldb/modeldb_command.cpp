@@ -2,6 +2,7 @@
 // and migrate it. Compiled only into the ecvpose executable; reads flags into options and calls ecv_modeldb.
 
 #include <cstdio>
+#include <fstream>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -34,6 +35,7 @@ struct ModeldbArgs {
   double distance_m = ModelBuildOptions().distance_m;
   std::string shading = "unlit";
   bool symmetric = false;
+  std::string feature_settings;  // JSON file of FeatureSettings; empty: the defaults
   // list, info, remove, export, verify
   std::string model;
   bool json = false;
@@ -71,6 +73,19 @@ ModelBuildOptions BuildArguments(const ModeldbArgs& args) {
   options.distance_m = args.distance_m;
   options.camera = CameraArgument(args);
   options.render.shading = args.shading == "headlight" ? Shading::kHeadlight : Shading::kUnlit;
+  if (!args.feature_settings.empty()) {  // --feature-settings: e.g. {"descriptor": {"pairs": 1}}
+    std::ifstream file(args.feature_settings);
+    std::stringstream text;
+    text << file.rdbuf();
+    if (!file) ThrowInputError(args.feature_settings, "--feature-settings", "a readable JSON file");
+    options.features = FeatureSettingsFromJson(text.str(), args.feature_settings);
+    try {
+      options.features.ecv.Check();
+      options.features.descriptor.Check();
+    } catch (const InputError& error) {
+      ThrowInputError(args.feature_settings, "--feature-settings", "settings in their ranges", error.what());
+    }
+  }
   options.Check();
   return options;
 }
@@ -298,6 +313,9 @@ void AddBuildFlags(CLI::App& build, ModeldbArgs* args) {
       ->check(CLI::IsMember({"unlit", "headlight"}))
       ->capture_default_str();
   build.add_flag("--symmetric", args->symmetric, "Mark the models symmetric (evaluated with ADD-S)");
+  build.add_option("--feature-settings", args->feature_settings,
+                   "JSON of extraction and descriptor settings, {\"ecv\": {...}, \"descriptor\": {...}} as "
+                   "`modeldb info` shows them (missing fields: defaults)");
   build.footer(
       "A directory holds one folder per model, <name>/<name>.obj, with object_from_mesh.json beside the mesh when\n"
       "the mesh's frame differs from the object frame; --object-from-mesh FILE overrides those for every mesh.\n"

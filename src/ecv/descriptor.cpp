@@ -13,19 +13,19 @@
 namespace ecv {
 namespace {
 
-// Adds `value` to a 16-bin histogram over [low, 1].
-void AddToHistogram(float value, float low, bool soft, float* histogram) {
-  const float position = (value - low) / (1.0F - low) * kDescriptorBins - 0.5F;  // bin centres at integers
+// Adds `weight` at `value` to a histogram of `bins` bins over [low, 1].
+void AddToHistogram(float value, float low, bool soft, float weight, int bins, float* histogram) {
+  const float position = (value - low) / (1.0F - low) * static_cast<float>(bins) - 0.5F;  // bin centres at integers
   if (!soft) {
-    const int bin = std::clamp(static_cast<int>(position + 0.5F), 0, kDescriptorBins - 1);  // position >= -0.5
-    histogram[bin] += 1.0F;
+    const int bin = std::clamp(static_cast<int>(std::max(position, -0.5F) + 0.5F), 0, bins - 1);
+    histogram[bin] += weight;
     return;
   }
-  const float clamped = std::clamp(position, 0.0F, static_cast<float>(kDescriptorBins - 1));
-  const int lower = std::min(static_cast<int>(clamped), kDescriptorBins - 2);
+  const float clamped = std::clamp(position, 0.0F, static_cast<float>(bins - 1));
+  const int lower = std::min(static_cast<int>(clamped), bins - 2);
   const float upper_share = clamped - static_cast<float>(lower);
-  histogram[lower] += 1.0F - upper_share;
-  histogram[lower + 1] += upper_share;
+  histogram[lower] += weight * (1.0F - upper_share);
+  histogram[lower + 1] += weight * upper_share;
 }
 
 // Colours scaled per channel so that their mean is 0.5 (grey world), clamped to [0, 1].
@@ -38,29 +38,102 @@ std::vector<Primitive> BalanceColors(std::vector<Primitive> primitives) {
   return primitives;
 }
 
-// Histograms of the pairs of `neighbours` (indices into primitives, sorted by distance to the source).
-void DescribeContext(const std::vector<Primitive>& primitives, const std::vector<int>& neighbours,
-                     const DescriptorOptions& options, float* descriptor) {
-  std::fill(descriptor, descriptor + kDescriptorSize, 0.0F);
+constexpr float kLogFloor = 0.02F;                // added before a logarithm: dark colours, weak magnitudes
+constexpr float kColorLogRange = 1.3862944F;      // ln 4: colour log ratios over [-ln 4, ln 4]
+constexpr float kMagnitudeLogRange = 2.0794415F;  // ln 8: magnitude log ratios over [-ln 8, ln 8]
+constexpr float kPi = 3.14159265F;
+
+// The appearance histograms' values of a pair are differences of per-primitive values: value k of the
+// pair {a, b} = clamp(wrap_k(v_b[k] - v_a[k]) * scale[k]), wrapped into [-period/2, period/2) when the
+// value is an angle (period > 0).
+struct AppearanceValues {
+  std::vector<Eigen::Vector3f> values;  // one per primitive
+  Eigen::Vector3f scale = Eigen::Vector3f::Ones();
+  Eigen::Vector3f period = Eigen::Vector3f::Zero();
+};
+
+AppearanceValues ComputeAppearance(const std::vector<Primitive>& primitives, DescriptorAppearance kind) {
+  AppearanceValues appearance;
+  appearance.values.reserve(primitives.size());
+  auto log = [](float value) { return std::log(std::max(value, 0.0F) + kLogFloor); };
+  for (const Primitive& p : primitives) {
+    switch (kind) {
+      case DescriptorAppearance::kRgbDifference: appearance.values.push_back(p.color); break;
+      case DescriptorAppearance::kRgbLogRatio:
+        appearance.values.emplace_back(log(p.color[0]), log(p.color[1]), log(p.color[2]));
+        break;
+      case DescriptorAppearance::kMonogenic:
+        appearance.values.emplace_back(log(p.magnitude), p.image_orientation, log(p.color.mean()));
+        break;
+    }
+  }
+  if (kind == DescriptorAppearance::kRgbLogRatio) appearance.scale.setConstant(1.0F / kColorLogRange);
+  if (kind == DescriptorAppearance::kMonogenic) {
+    appearance.scale = Eigen::Vector3f(1.0F / kMagnitudeLogRange, 2.0F / kPi, 1.0F / kColorLogRange);
+    appearance.period = Eigen::Vector3f(0.0F, kPi, 0.0F);  // orientations are modulo pi
+  }
+  return appearance;
+}
+
+// The context of one source: its primitives, appearance values and histogramming options.
+struct Context {
+  const std::vector<Primitive>& primitives;
+  const AppearanceValues& appearance;
+  const DescriptorOptions& options;
+};
+
+// Adds the pair {a, b} (a the closer to the source) with `weight` to the six histograms, in their radial
+// `shell` (0 .. shells - 1) when they are split into radial shells.
+void AddPair(const Context& context, int a_index, int b_index, float weight, int shell, float* descriptor) {
+  const Primitive& a = context.primitives[static_cast<size_t>(a_index)];
+  const Primitive& b = context.primitives[static_cast<size_t>(b_index)];
+  const Eigen::Vector3f offset = b.position - a.position;
+  const float length = offset.norm();
+  if (length <= 0.0F || weight <= 0.0F) return;
+  const DescriptorOptions& options = context.options;
+  const Eigen::Vector3f d = offset / length;
+  float cosines[3] = {a.orientation.dot(b.orientation), a.orientation.dot(d), b.orientation.dot(d)};
+  if (options.unsigned_segments) {
+    for (float& cosine : cosines) cosine = std::abs(cosine);
+  }
   const float cosine_low = options.unsigned_segments ? 0.0F : -1.0F;
-  for (size_t i = 0; i < neighbours.size(); ++i) {
-    const Primitive& a = primitives[static_cast<size_t>(neighbours[i])];
-    for (size_t j = i + 1; j < neighbours.size(); ++j) {
-      const Primitive& b = primitives[static_cast<size_t>(neighbours[j])];
-      const Eigen::Vector3f offset = b.position - a.position;
-      const float length = offset.norm();
-      if (length <= 0.0F) continue;
-      const Eigen::Vector3f d = offset / length;
-      float cosines[3] = {a.orientation.dot(b.orientation), a.orientation.dot(d), b.orientation.dot(d)};
-      if (options.unsigned_segments) {
-        for (float& cosine : cosines) cosine = std::abs(cosine);
-      }
-      for (int k = 0; k < 3; ++k)
-        AddToHistogram(cosines[k], cosine_low, options.soft_binning, descriptor + k * kDescriptorBins);
-      if (!options.use_color) continue;
-      for (int k = 0; k < 3; ++k) {
-        AddToHistogram(b.color[k] - a.color[k], -1.0F, options.soft_binning, descriptor + (3 + k) * kDescriptorBins);
-      }
+  const int bins = kDescriptorBins / options.shells;
+  descriptor += shell * bins;
+  for (int k = 0; k < 3; ++k)
+    AddToHistogram(cosines[k], cosine_low, options.soft_binning, weight, bins, descriptor + k * kDescriptorBins);
+  if (!options.use_color) return;
+  const AppearanceValues& values = context.appearance;
+  const Eigen::Vector3f difference =
+      values.values[static_cast<size_t>(b_index)] - values.values[static_cast<size_t>(a_index)];
+  for (int k = 0; k < 3; ++k) {
+    float value = difference[k];
+    if (values.period[k] > 0.0F) value -= values.period[k] * std::floor(value / values.period[k] + 0.5F);
+    AddToHistogram(value * values.scale[k], -1.0F, options.soft_binning, weight, bins,
+                   descriptor + (3 + k) * kDescriptorBins);
+  }
+}
+
+// Histograms of the pairs of `neighbours` (indices into primitives, sorted by distance to the source,
+// `distances` from it in metres), all pairs or those with the source, then normalised.
+void DescribeContext(const Context& context, int source, const std::vector<int>& neighbours,
+                     const std::vector<float>& distances, float* descriptor) {
+  std::fill(descriptor, descriptor + kDescriptorSize, 0.0F);
+  const DescriptorOptions& options = context.options;
+  const float falloff = static_cast<float>(options.closeness_weight / options.radius_m);
+  const float inverse_squared_radius = static_cast<float>(1.0 / (options.radius_m * options.radius_m));
+  auto shell = [&](size_t j) {  // shells of equal area: by the squared distance from the source
+    const float share = distances[j] * distances[j] * inverse_squared_radius;
+    return std::min(static_cast<int>(share * static_cast<float>(options.shells)), options.shells - 1);
+  };
+  if (options.pairs == DescriptorPairs::kSource) {
+    for (size_t j = 0; j < neighbours.size(); ++j) {
+      if (neighbours[j] != source)
+        AddPair(context, source, neighbours[j], 1.0F - falloff * distances[j], shell(j), descriptor);
+    }
+  } else {
+    for (size_t i = 0; i < neighbours.size(); ++i) {
+      for (size_t j = i + 1; j < neighbours.size(); ++j)
+        AddPair(context, neighbours[i], neighbours[j], 1.0F - falloff * distances[j], shell(j), descriptor);
     }
   }
   for (int h = 0; h < 6; ++h) {
@@ -81,6 +154,21 @@ void DescriptorOptions::Check() const {
   }
   if (!(radius_m > 0.0) || !std::isfinite(radius_m)) {
     ThrowInputError("descriptor options", "radius_m", "a radius > 0 m", std::to_string(radius_m));
+  }
+  if (pairs != DescriptorPairs::kAll && pairs != DescriptorPairs::kSource) {
+    ThrowInputError("descriptor options", "pairs", "0 (all pairs) or 1 (source pairs)",
+                    std::to_string(static_cast<int>(pairs)));
+  }
+  const int kind = static_cast<int>(appearance);
+  if (kind < 0 || kind > static_cast<int>(DescriptorAppearance::kMonogenic)) {
+    ThrowInputError("descriptor options", "appearance", "0 (RGB differences), 1 (RGB log ratios) or 2 (monogenic)",
+                    std::to_string(kind));
+  }
+  if (shells != 1 && shells != 2 && shells != 4) {
+    ThrowInputError("descriptor options", "shells", "1, 2 or 4", std::to_string(shells));
+  }
+  if (!(closeness_weight >= 0.0 && closeness_weight <= 1.0)) {
+    ThrowInputError("descriptor options", "closeness_weight", "a weight in [0, 1]", std::to_string(closeness_weight));
   }
 }
 
@@ -107,21 +195,25 @@ Descriptors ComputeDescriptors(const std::vector<Primitive>& input, const Descri
   std::vector<std::vector<float>> distances;
   index.radiusSearch(points, neighbour_lists, distances, squared_radius, search);
 
+  const AppearanceValues appearance = ComputeAppearance(primitives, options.appearance);
+  const Context context{primitives, appearance, options};
   cv::Mat values(static_cast<int>(primitives.size()), kDescriptorSize, CV_32F);
   std::vector<int> neighbours;
+  std::vector<float> neighbour_distances;
   for (size_t i = 0; i < primitives.size(); ++i) {
     if (neighbour_lists[i].size() < 2) continue;            // isolated: no context
     const std::vector<size_t>& found = neighbour_lists[i];  // by distance, the source first
     const size_t cap = options.max_neighbours > 0 ? static_cast<size_t>(options.max_neighbours) : found.size();
     neighbours.clear();
-    if (found.size() <= cap) {
-      neighbours.assign(found.begin(), found.end());
-    } else {  // evenly spread over the distance ranks, so that the context still spans the whole radius
-      for (size_t j = 0; j < cap; ++j)
-        neighbours.push_back(static_cast<int>(found[j * (found.size() - 1) / (cap - 1)]));
+    neighbour_distances.clear();
+    for (size_t j = 0; j < std::min(cap, found.size()); ++j) {
+      // All, or evenly spread over the distance ranks, so that the context still spans the whole radius.
+      const size_t k = found.size() <= cap ? j : j * (found.size() - 1) / (cap - 1);
+      neighbours.push_back(static_cast<int>(found[k]));
+      neighbour_distances.push_back(std::sqrt(distances[i][k]));
     }
     float* row = values.ptr<float>(static_cast<int>(descriptors.primitive.size()));
-    DescribeContext(primitives, neighbours, options, row);
+    DescribeContext(context, static_cast<int>(i), neighbours, neighbour_distances, row);
     descriptors.primitive.push_back(static_cast<int>(i));
   }
   descriptors.values = values.rowRange(0, static_cast<int>(descriptors.primitive.size())).clone();

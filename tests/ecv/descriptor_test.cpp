@@ -24,8 +24,54 @@ std::vector<Primitive> RandomPrimitives(int count, unsigned seed) {
     p.position = Eigen::Vector3f(unit(random), unit(random), unit(random)) * 0.12F + Eigen::Vector3f(0, 0, 0.8F);
     p.orientation = Eigen::Vector3f(normal(random), normal(random), normal(random)).normalized();
     p.color = Eigen::Vector3f(unit(random), unit(random), unit(random));
+    p.magnitude = 0.02F + 0.3F * unit(random);
+    p.image_orientation = 3.14159F * unit(random);
   }
   return primitives;
+}
+
+// The descriptor variants beyond the paper's (issue 5), each with one option changed from the defaults.
+std::vector<std::pair<std::string, DescriptorOptions>> Variants() {
+  std::vector<std::pair<std::string, DescriptorOptions>> variants(6);
+  variants[0].first = "defaults";
+  variants[1].first = "source pairs";
+  variants[1].second.pairs = DescriptorPairs::kSource;
+  variants[2].first = "closeness weight";
+  variants[2].second.closeness_weight = 0.7;
+  variants[3].first = "RGB log ratios";
+  variants[3].second.appearance = DescriptorAppearance::kRgbLogRatio;
+  variants[4].first = "monogenic";
+  variants[4].second.appearance = DescriptorAppearance::kMonogenic;
+  variants[5].first = "two shells";
+  variants[5].second.shells = 2;
+  return variants;
+}
+
+// One histogram (0..5) of a descriptor row, as a vector.
+std::vector<float> Histogram(const Descriptors& descriptors, int row, int h) {
+  const float* values = descriptors.values.ptr<float>(row) + h * kDescriptorBins;
+  return std::vector<float>(values, values + kDescriptorBins);
+}
+
+// A histogram with the given (bin, value) entries.
+std::vector<float> Expected(std::initializer_list<std::pair<int, float>> entries) {
+  std::vector<float> histogram(kDescriptorBins, 0.0F);
+  for (const auto& [bin, value] : entries) histogram[static_cast<size_t>(bin)] = value;
+  return histogram;
+}
+
+void ExpectHistogram(const std::vector<float>& actual, const std::vector<float>& expected, const std::string& what) {
+  for (int bin = 0; bin < kDescriptorBins; ++bin) {
+    EXPECT_NEAR(actual[static_cast<size_t>(bin)], expected[static_cast<size_t>(bin)], 1e-5) << what << " bin " << bin;
+  }
+}
+
+// Hard bins and plain sums, so that each pair adds its weight to exactly one bin.
+DescriptorOptions CountingOptions() {
+  DescriptorOptions options;
+  options.soft_binning = false;
+  options.hellinger = false;
+  return options;
 }
 
 Eigen::Isometry3d SomeRigidMotion() {
@@ -68,15 +114,124 @@ TEST(EcvDescriptor, InvariantToRigidMotionAndNormalised) {
   }
 }
 
+TEST(EcvDescriptor, VariantsInvariantToRigidMotionAndNormalised) {
+  const std::vector<Primitive> primitives = RandomPrimitives(300, 5);
+  for (const auto& [name, options] : Variants()) {
+    const Descriptors original = ComputeDescriptors(primitives, options);
+    const Descriptors moved = ComputeDescriptors(Moved(primitives, SomeRigidMotion()), options);
+    ASSERT_EQ(original.primitive, moved.primitive) << name;
+    ASSERT_GT(original.values.rows, 280) << name;
+    EXPECT_LT(cv::norm(original.values, moved.values, cv::NORM_L1) / original.values.rows, 1e-3) << name;
+    for (int row = 0; row < original.values.rows; ++row) {
+      for (int h = 0; h < 6; ++h) {
+        const cv::Mat histogram = original.values.row(row).colRange(h * kDescriptorBins, (h + 1) * kDescriptorBins);
+        ASSERT_NEAR(histogram.dot(histogram), 1.0, 1e-5) << name << " row " << row << " histogram " << h;
+      }
+    }
+  }
+}
+
 TEST(EcvDescriptor, IsolatedPrimitivesGetNone) {
   std::vector<Primitive> primitives = RandomPrimitives(3, 2);
   primitives[0].position = {0, 0, 1};
   primitives[1].position = {0.01F, 0, 1};  // 1 cm from the first: a context of two
   primitives[2].position = {0.5F, 0, 1};   // alone
-  const Descriptors descriptors = ComputeDescriptors(primitives);
-  EXPECT_EQ(descriptors.primitive, (std::vector<int>{0, 1}));
-  EXPECT_TRUE(ComputeDescriptors({}).primitive.empty());
-  EXPECT_TRUE(ComputeDescriptors({primitives[2]}).primitive.empty());
+  for (const auto& [name, options] : Variants()) {
+    const Descriptors descriptors = ComputeDescriptors(primitives, options);
+    EXPECT_EQ(descriptors.primitive, (std::vector<int>{0, 1})) << name;
+    EXPECT_TRUE(ComputeDescriptors({}, options).primitive.empty()) << name;
+    EXPECT_TRUE(ComputeDescriptors({primitives[2]}, options).primitive.empty()) << name;
+  }
+}
+
+// A source s with two neighbours 1 and 2 cm away whose cosines avoid bin edges (bins of 1/8 over [-1, 1]):
+// pair {s, n1}: o_s.o_n1 = 0.8 (bin 14), o_s.d = 0.8 (14), o_n1.d = 1 (15);
+// pair {s, n2}: o_s.o_n2 = 0.8 (14), o_s.d = 0.8 (14), o_n2.d = 0.28 (10);
+// pair {n1, n2}: o_n1.o_n2 = 0.64 (13), o_n1.d = 0.18 (9), o_n2.d = -0.05 (7).
+std::vector<Primitive> SourceWithTwoNeighbours() {
+  std::vector<Primitive> primitives(3);
+  const Eigen::Vector3f origin(0.1F, -0.05F, 0.9F);
+  primitives[0].position = origin;
+  primitives[0].orientation = Eigen::Vector3f(0.0F, 0.0F, 1.0F);
+  primitives[1].position = origin + 0.01F * Eigen::Vector3f(0.6F, 0.0F, 0.8F);
+  primitives[1].orientation = Eigen::Vector3f(0.6F, 0.0F, 0.8F);
+  primitives[2].position = origin + 0.02F * Eigen::Vector3f(0.0F, -0.6F, 0.8F);
+  primitives[2].orientation = Eigen::Vector3f(0.0F, 0.6F, 0.8F);
+  return primitives;
+}
+
+TEST(EcvDescriptor, AllPairsAndSourcePairsFillTheirBins) {
+  const std::vector<Primitive> primitives = SourceWithTwoNeighbours();
+  DescriptorOptions options = CountingOptions();
+  Descriptors all = ComputeDescriptors(primitives, options);
+  ASSERT_EQ(all.primitive, (std::vector<int>{0, 1, 2}));
+  const float third = 1.0F / 3.0F;
+  ExpectHistogram(Histogram(all, 0, 0), Expected({{14, 2 * third}, {13, third}}), "all pairs R_G1");
+  ExpectHistogram(Histogram(all, 0, 1), Expected({{14, 2 * third}, {9, third}}), "all pairs R_G2");
+  ExpectHistogram(Histogram(all, 0, 2), Expected({{15, third}, {10, third}, {7, third}}), "all pairs R_G3");
+
+  options.pairs = DescriptorPairs::kSource;  // only {s, n1} and {s, n2}
+  const Descriptors source = ComputeDescriptors(primitives, options);
+  ASSERT_EQ(source.primitive, (std::vector<int>{0, 1, 2}));
+  ExpectHistogram(Histogram(source, 0, 0), Expected({{14, 1.0F}}), "source pairs R_G1");
+  ExpectHistogram(Histogram(source, 0, 1), Expected({{14, 1.0F}}), "source pairs R_G2");
+  ExpectHistogram(Histogram(source, 0, 2), Expected({{15, 0.5F}, {10, 0.5F}}), "source pairs R_G3");
+  // Seen from n2, its pairs are {n2, s} and {n2, n1}: o_n2.o_s = 0.8 and o_n2.o_n1 = 0.64.
+  ExpectHistogram(Histogram(source, 2, 0), Expected({{14, 0.5F}, {13, 0.5F}}), "source pairs of n2, R_G1");
+
+  options.closeness_weight = 1.0;  // weights 1 - 0.01/0.025 = 0.6 for n1 and 1 - 0.02/0.025 = 0.2 for n2
+  const Descriptors weighted = ComputeDescriptors(primitives, options);
+  ExpectHistogram(Histogram(weighted, 0, 2), Expected({{15, 0.75F}, {10, 0.25F}}), "weighted source pairs R_G3");
+
+  // Two shells split at 2.5 cm / sqrt 2 = 1.77 cm: n1 (1 cm) fills bins 0-7, n2 (2 cm) bins 8-15, 8 bins each
+  // over [-1, 1]: 0.8 -> bin 7, 1 -> bin 7, 0.28 -> bin 5.
+  options.closeness_weight = 0.0;
+  options.shells = 2;
+  const Descriptors shells = ComputeDescriptors(primitives, options);
+  ExpectHistogram(Histogram(shells, 0, 0), Expected({{7, 0.5F}, {8 + 7, 0.5F}}), "two shells R_G1");
+  ExpectHistogram(Histogram(shells, 0, 2), Expected({{7, 0.5F}, {8 + 5, 0.5F}}), "two shells R_G3");
+  // Four shells of equal area, 4 bins each: (1 / 2.5)^2 = 0.16 -> shell 0 and (2 / 2.5)^2 = 0.64 -> shell 2
+  // (by distance instead of area n1 would fall into shell 1); 0.8 -> bin 3.
+  options.shells = 4;
+  const Descriptors four = ComputeDescriptors(primitives, options);
+  ExpectHistogram(Histogram(four, 0, 0), Expected({{3, 0.5F}, {2 * 4 + 3, 0.5F}}), "four shells R_G1");
+}
+
+TEST(EcvDescriptor, AppearanceVariantsFillTheirBins) {
+  std::vector<Primitive> primitives(2);
+  primitives[1].position = {0.01F, 0.0F, 0.0F};
+  // Colours + 0.02 (the floor before logarithms): s (0.2, 0.4, 0.3), n (0.3, 0.1, 0.36): ratios 1.5, 0.25, 1.2.
+  primitives[0].color = {0.18F, 0.38F, 0.28F};
+  primitives[1].color = {0.28F, 0.08F, 0.34F};
+  primitives[0].magnitude = 0.08F;  // + 0.02: ratio 3
+  primitives[1].magnitude = 0.28F;
+  primitives[0].image_orientation = 0.1F;  // 2.9 rad apart = -0.2416 rad modulo pi
+  primitives[1].image_orientation = 3.0F;
+  DescriptorOptions options = CountingOptions();
+
+  // Differences of the source's context: 0.1, -0.3, 0.06 (the paper's R_Ak).
+  Descriptors descriptors = ComputeDescriptors(primitives, options);
+  ExpectHistogram(Histogram(descriptors, 0, 3), Expected({{8, 1.0F}}), "RGB difference R");
+  ExpectHistogram(Histogram(descriptors, 0, 4), Expected({{5, 1.0F}}), "RGB difference G");
+  ExpectHistogram(Histogram(descriptors, 0, 5), Expected({{8, 1.0F}}), "RGB difference B");
+
+  // ln(ratio) / ln 4: 0.292 (bin 10), -1 (bin 0), 0.132 (bin 9).
+  options.appearance = DescriptorAppearance::kRgbLogRatio;
+  descriptors = ComputeDescriptors(primitives, options);
+  ExpectHistogram(Histogram(descriptors, 0, 3), Expected({{10, 1.0F}}), "RGB log ratio R");
+  ExpectHistogram(Histogram(descriptors, 0, 4), Expected({{0, 1.0F}}), "RGB log ratio G");
+  ExpectHistogram(Histogram(descriptors, 0, 5), Expected({{9, 1.0F}}), "RGB log ratio B");
+
+  // ln 3 / ln 8 = 0.528 (bin 12); -0.2416 / (pi / 2) = -0.154 (bin 6; unwrapped 1.85 would clamp to 15);
+  // lightness with the floor 0.30 -> 0.2533: ln(0.8444) / ln 4 = -0.122 (bin 7).
+  options.appearance = DescriptorAppearance::kMonogenic;
+  descriptors = ComputeDescriptors(primitives, options);
+  ExpectHistogram(Histogram(descriptors, 0, 3), Expected({{12, 1.0F}}), "monogenic magnitude ratio");
+  ExpectHistogram(Histogram(descriptors, 0, 4), Expected({{6, 1.0F}}), "monogenic orientation difference");
+  ExpectHistogram(Histogram(descriptors, 0, 5), Expected({{7, 1.0F}}), "monogenic lightness ratio");
+  // Seen from n: the same pair reversed mirrors each value (bins 3, 9).
+  ExpectHistogram(Histogram(descriptors, 1, 3), Expected({{3, 1.0F}}), "monogenic magnitude ratio, reversed");
+  ExpectHistogram(Histogram(descriptors, 1, 4), Expected({{9, 1.0F}}), "monogenic orientation, reversed");
 }
 
 TEST(EcvDescriptor, SegmentSignMattersOnlyWhenSigned) {
