@@ -1,6 +1,7 @@
 // `ecvpose recognize --db lib.sqlite FRAME`: finds the library's objects in an RGB-D frame.
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -109,9 +110,6 @@ int RunRecognize(const RecognizeArgs& args) {
     ThrowInputError("recognize", "--sequence", "either a sequence or one frame, not both");
   }
   if (args.track && args.sequence.empty()) ThrowInputError("recognize", "--track", "a --sequence to track along");
-  if (!args.sequence.empty() && !args.overlay.empty()) {
-    ThrowInputError("recognize", "--overlay", "one frame (not with --sequence)");
-  }
   std::vector<std::string> frames;
   if (!args.sequence.empty()) frames = ListSequenceFrames(args.sequence);
   LibraryLoadOptions load;
@@ -144,6 +142,7 @@ int RunRecognize(const RecognizeArgs& args) {
   int failed = 0;
   double total_ms = 0.0;
   std::vector<Detection> previous;  // the last frame's detections, the priors when tracking
+  if (!args.overlay.empty()) std::filesystem::create_directories(args.overlay);
   for (size_t i = 0; i < frames.size(); ++i) {
     FrameSpec spec;
     spec.positional = frames[i];
@@ -160,6 +159,11 @@ int RunRecognize(const RecognizeArgs& args) {
       line["frame"] = frames[i];
       lines << line.dump() << '\n';
       if (!args.out_bop.empty()) AppendBopRows(csv, ids.first, ids.second, result);
+      if (!args.overlay.empty()) {
+        char name[32];
+        std::snprintf(name, sizeof(name), "/%04zu.png", i + 1);
+        WriteColorImage(args.overlay + name, recognizer.DrawDetections(loaded.rgbd, result.detections));
+      }
     } catch (const InputError& error) {
       ++failed;
       previous.clear();
@@ -196,7 +200,9 @@ CommandAction SetupRecognizeCommand(CLI::App& command) {
                      "Detections as BOP CSV (scene_id,im_id,obj_id,score,R,t,time; t in mm)");
   command.add_option("--scene-id", args->scene_id, "BOP scene id (default: from the frame name)");
   command.add_option("--image-id", args->image_id, "BOP image id (default: from the frame name)");
-  command.add_option("--overlay", args->overlay, "Picture: each detected model in red with its name (PNG)");
+  command.add_option("--overlay", args->overlay,
+                     "Picture: each detected model in red with its name (PNG); with --sequence a directory,\n"
+                     "one DIR/0001.png ... per frame in sequence order");
   RecognizerOptions& options = args->options;
   options.ransac.threads = static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
   command.add_option("--views-per-model", options.views_per_model, "Library views tried with RANSAC per model")

@@ -3,6 +3,7 @@
 // `ecvpose modeldb build`, then `ecvpose recognize --sequence` over frame 000001 of videos 0000, 0001 and
 // 0002 (7 textured objects in all), scored against the ground truth.
 
+#include <filesystem>
 #include <fstream>
 
 #include <gtest/gtest.h>
@@ -110,8 +111,13 @@ TEST_F(YcbvLibrary, SameSeedSameOutputWithOneOrTwoThreads) {
 TEST_F(YcbvLibrary, TracksTheThreeObjectsOfVideo0001FromFrameToFrame) {
   const std::string scenes = test::DataPath("ycbv_subset/Example-Scenes/0001/");
   const std::vector<std::string> frames = {scenes + "000001", scenes + "000003", scenes + "000005", scenes + "000007"};
-  const std::vector<nlohmann::json> lines = Recognize("track", "--track", frames);
+  const std::string overlays = directory_->File("track_overlays");
+  const std::vector<nlohmann::json> lines = Recognize("track", "--track --overlay " + overlays, frames);
   ASSERT_EQ(lines.size(), frames.size());
+  for (const char* picture : {"/0001.png", "/0002.png", "/0003.png", "/0004.png"}) {  // one per frame, in order
+    EXPECT_EQ(ReadColorImage(overlays + picture).size(), cv::Size(640, 480)) << picture;
+  }
+  EXPECT_FALSE(std::filesystem::exists(overlays + "/0005.png"));
   LibraryLoadOptions load;
   load.build_matchers = false;
   const ModelLibrary library = ModelLibrary::Load(library_, load);
