@@ -65,11 +65,12 @@ Descriptors SampleRows(const Descriptors& descriptors, size_t count, uint64_t se
 }
 
 // A verified pose: the detection, the pixels (at dense_stride_px) where its rendered surface lies on the
-// scene's, which overlap suppression compares, and the rendered surface in the object frame, which ICP fits.
+// scene's, which overlap suppression compares, and the rendered depth (for the frame's camera sampled at
+// dense_stride_px), from which ICP takes the model's surface.
 struct Verified {
   Detection detection;
   std::vector<cv::Point> surface;
-  std::vector<Eigen::Vector3f> object_points;
+  cv::Mat depth;
 };
 
 // A pose hypothesis of a model from one of its views.
@@ -151,14 +152,12 @@ class Recognizer::Impl {
     std::vector<bool> done(library_.models().size(), false);
     Clock::time_point stage = Clock::now();
     for (const Detection& prior : priors) {
-      const auto model = std::find_if(records_.begin(), records_.end(),
-                                      [&](const ModelRecord& record) { return record.name == prior.model; });
-      const size_t m = static_cast<size_t>(model - records_.begin());
-      if (model == records_.end() || done[m]) continue;
-      std::optional<Verified> tracked = Track(m, prior, scene);
-      if (tracked && Accepted(tracked->detection)) {
-        candidates.push_back(std::move(*tracked));
-        done[m] = true;
+      const std::optional<size_t> m = ModelIndex(prior.model);
+      if (!m || done[*m]) continue;
+      Verified tracked = Track(*m, prior, scene);
+      if (Accepted(tracked.detection)) {
+        candidates.push_back(std::move(tracked));
+        done[*m] = true;
       }
     }
     if (!priors.empty()) result.timings_ms["track"] = MillisecondsSince(stage);
@@ -179,18 +178,25 @@ class Recognizer::Impl {
   }
 
  private:
+  std::optional<size_t> ModelIndex(const std::string& name) const {
+    for (size_t m = 0; m < records_.size(); ++m) {
+      if (records_[m].name == name) return m;
+    }
+    return std::nullopt;
+  }
+
   bool Accepted(const Detection& detection) const {
     return detection.score >= options_.min_score && detection.visible_fraction >= options_.min_visible_fraction;
   }
 
   // A prior's model at the prior's pose, refined by ICP when that raises the score (its RANSAC fields stay 0).
-  std::optional<Verified> Track(size_t model, const Detection& prior, const Scene& scene) {
+  Verified Track(size_t model, const Detection& prior, const Scene& scene) {
     Hypothesis hypothesis;
     hypothesis.view = prior.view;
     hypothesis.pose = prior.camera_from_object;
     Verified best = Verify(model, scene, hypothesis);
     if (options_.refine) {
-      Refine(model, scene, best.object_points, &hypothesis);
+      Refine(model, scene, best.depth, &hypothesis);
       Verified refined = Verify(model, scene, hypothesis);
       if (refined.detection.score >= best.detection.score) best = std::move(refined);
     }
@@ -273,7 +279,7 @@ class Recognizer::Impl {
     // 70 YCB-Video objects, for 3x the ICP time.
     stage = Clock::now();
     Hypothesis refined = *best_hypothesis;
-    Refine(model, scene, best->object_points, &refined);
+    Refine(model, scene, best->depth, &refined);
     (*timings_ms)["refine"] += MillisecondsSince(stage);
     stage = Clock::now();
     Verified verified = Verify(model, scene, refined);
@@ -358,10 +364,18 @@ class Recognizer::Impl {
     return hypotheses;
   }
 
-  // Point-to-plane ICP of the model's surface as rendered at the pose (`object_points`, object frame) against
+  // Point-to-plane ICP of the model's surface as rendered at the pose (`rendered_depth`, from Verify) against
   // the scene points near it.
-  void Refine(size_t model, const Scene& scene, const std::vector<Eigen::Vector3f>& object_points,
-              Hypothesis* hypothesis) const {
+  void Refine(size_t model, const Scene& scene, const cv::Mat& rendered_depth, Hypothesis* hypothesis) const {
+    const PinholeCamera camera = scene.frame->camera.Sampled(options_.dense_stride_px);
+    const Eigen::Isometry3f object_from_camera = hypothesis->pose.inverse().cast<float>();
+    std::vector<Eigen::Vector3f> object_points;
+    for (int v = 0; v < rendered_depth.rows; ++v) {
+      for (int u = 0; u < rendered_depth.cols; ++u) {
+        const float z = rendered_depth.at<float>(v, u);
+        if (z > 0.0F) object_points.push_back(object_from_camera * camera.BackProject({u, v}, z).cast<float>());
+      }
+    }
     if (object_points.size() < 10) return;
     if (options_.projective_icp) {
       const IcpResult icp =
@@ -413,7 +427,6 @@ class Recognizer::Impl {
     } else {
       model_color = rendered.color;
     }
-    const Eigen::Isometry3f object_from_camera = hypothesis.pose.inverse().cast<float>();
     Eigen::Matrix3f to_scene = Eigen::Matrix3f::Identity();
     if (options_.use_color_matrix && library_model.color_matrix) {
       to_scene = library_model.color_matrix->model_to_scene.cast<float>();
@@ -427,7 +440,6 @@ class Recognizer::Impl {
         const float model_z = rendered.depth.at<float>(v, u);
         if (model_z <= 0.0F) continue;
         ++rendered_pixels;
-        verified.object_points.push_back(object_from_camera * camera.BackProject({u, v}, model_z).cast<float>());
         const int scene_u = u * stride, scene_v = v * stride;
         const float scene_z = frame.depth.at<float>(scene_v, scene_u);
         if (scene_z <= 0.0F || scene_z < model_z - tolerance) continue;  // no measurement, or hidden
@@ -440,6 +452,7 @@ class Recognizer::Impl {
                             Eigen::Vector3f(s[0], s[1], s[2]) / 255.0F);
       }
     }
+    verified.depth = rendered.depth;
     const int on_surface = static_cast<int>(verified.surface.size());
     Detection& detection = verified.detection;
     detection.color_agreement = ColorCorrelation(colors);
@@ -458,10 +471,8 @@ class Recognizer::Impl {
   cv::Mat DrawDetections(const RgbdFrame& frame, const std::vector<Detection>& detections) {
     std::vector<SceneObject> objects;
     for (const Detection& detection : detections) {
-      for (size_t m = 0; m < library_.models().size(); ++m) {
-        if (library_.models()[m].record.name == detection.model) {
-          objects.push_back({meshes_[m], detection.camera_from_object});
-        }
+      if (const std::optional<size_t> m = ModelIndex(detection.model)) {
+        objects.push_back({meshes_[*m], detection.camera_from_object});
       }
     }
     const OverlayOptions overlay;

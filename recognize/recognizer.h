@@ -94,8 +94,8 @@ struct Detection {
 /// Detections of one frame and where the time went.
 struct RecognitionResult {
   std::vector<Detection> detections;  ///< best score first, at most one per model, overlaps suppressed
-  std::map<std::string, double>
-      timings_ms;  ///< per stage: extract, describe, track, match, ransac, refine, verify, total
+  /// Per stage: extract, describe, track, match, ransac, refine, verify, total (a stage not run is absent).
+  std::map<std::string, double> timings_ms;
   int scene_primitives = 0;
 };
 
