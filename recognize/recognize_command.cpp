@@ -219,6 +219,10 @@ CommandAction SetupRecognizeCommand(CLI::App& command) {
   command.add_flag("--track", args->track,
                    "With --sequence: try each object first at its pose in the previous frame (refined and verified);\n"
                    "objects tracked so skip view ranking and RANSAC");
+  command
+      .add_option("--track-start-score", options.min_track_start_score,
+                  "With --track: a new detection is followed into the next frame only from this score on")
+      ->capture_default_str();
   command.add_flag("--fast-icp", options.projective_icp,
                    "ICP pairs points along the camera's rays (7x faster refinement, finds fewer objects)");
   command.footer(

@@ -112,6 +112,7 @@ void RecognizerOptions::Check() const {
   require(max_overlap >= 0.0 && max_overlap <= 1.0, "max_overlap", "in [0, 1]");
   require(color_blur_px >= 0.0, "color_blur_px", ">= 0 pixels");
   require(min_score >= 0.0 && min_score <= 1.0, "min_score", "in [0, 1]");
+  require(min_track_start_score >= 0.0 && min_track_start_score <= 1.0, "min_track_start_score", "in [0, 1]");
   require(min_visible_fraction >= 0.0 && min_visible_fraction <= 1.0, "min_visible_fraction", "in [0, 1]");
 }
 
@@ -153,7 +154,7 @@ class Recognizer::Impl {
     Clock::time_point stage = Clock::now();
     for (const Detection& prior : priors) {
       const std::optional<size_t> m = ModelIndex(prior.model);
-      if (!m || done[*m]) continue;
+      if (!m || done[*m] || (!prior.tracked && prior.score < options_.min_track_start_score)) continue;
       Verified tracked = Track(*m, prior, scene);
       if (Accepted(tracked.detection)) {
         candidates.push_back(std::move(tracked));

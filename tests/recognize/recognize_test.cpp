@@ -127,6 +127,28 @@ TEST_F(RecognizeEndToEnd, WhenEveryModelIsTrackedNoPrimitivesAreExtracted) {
   }
 }
 
+TEST_F(RecognizeEndToEnd, AFirstDetectionBelowTheTrackStartScoreIsNotFollowed) {
+  LibraryLoadOptions load;
+  load.build_matchers = false;
+  load.names = {"003_cracker_box"};
+  const ModelLibrary library = ModelLibrary::Load(library_, load);
+  const LoadedFrame frame = LoadYcbvFrame(Frame());
+  RecognizerOptions options;
+  std::vector<Detection> priors = Recognizer(library, options).Recognize(frame.rgbd).detections;
+  ASSERT_EQ(priors.size(), 1U);
+  options.min_track_start_score = std::min(1.0, priors[0].score + 0.01);
+  Recognizer recognizer(library, options);
+  const RecognitionResult fresh = recognizer.Recognize(frame.rgbd, priors);  // a first appearance, below the bar
+  ASSERT_EQ(fresh.detections.size(), 1U);
+  EXPECT_FALSE(fresh.detections[0].tracked);
+  EXPECT_GT(fresh.scene_primitives, 0);
+  priors[0].tracked = true;  // a track already followed is kept while it scores min_score
+  const RecognitionResult kept = recognizer.Recognize(frame.rgbd, priors);
+  ASSERT_EQ(kept.detections.size(), 1U);
+  EXPECT_TRUE(kept.detections[0].tracked);
+  EXPECT_EQ(kept.scene_primitives, 0);
+}
+
 TEST_F(RecognizeEndToEnd, BadInputIsReported) {
   const test::CommandResult missing_db = test::RunCli("recognize --db /nonexistent/lib.sqlite " + Frame());
   EXPECT_EQ(missing_db.exit_code, 1) << missing_db.output;
