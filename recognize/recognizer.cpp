@@ -86,6 +86,10 @@ RansacOptions RecognizerOptions::DefaultRansac() {
   RansacOptions options;           // the paper's numbers
   options.adaptive = true;         // beyond the paper: stop once the best pose shows the sampled views are easy
   options.prefer_agreeing = true;  // and rank poses by agreeing (appearance-bearing) correspondences
+  // At most 10 000 samples per view instead of the paper's 37 000 (w = 0.05), spent on more views instead: on
+  // the 30 YCB-Video frames, 5 views at 10 000 found 49 of 70 objects in the RANSAC time of 3 views at 37 000
+  // (45 of 70); 5 views at 5000 found 41.
+  options.max_iterations = 10000;
   return options;
 }
 
@@ -478,10 +482,22 @@ class Recognizer::Impl {
     }
     const OverlayOptions overlay;
     RenderResult rendered = renderer_.RenderScene(objects, frame.camera, OverlayRenderOptions(overlay));
-    for (int v = 0; v < rendered.depth.rows; ++v) {  // scene surfaces in front of a model hide it
+    // Scene surfaces in front of a model hide it; so do pixels without a scene depth next to hidden ones (holes
+    // in the depth of a shiny surface in front would otherwise let specks of the model show through).
+    cv::Mat hidden = cv::Mat::zeros(rendered.depth.size(), CV_8UC1);
+    for (int v = 0; v < rendered.depth.rows; ++v) {
       for (int u = 0; u < rendered.depth.cols; ++u) {
         const float scene_z = frame.depth.at<float>(v, u), model_z = rendered.depth.at<float>(v, u);
         if (model_z > 0.0F && scene_z > 0.0F && scene_z < model_z - static_cast<float>(options_.depth_tolerance_m)) {
+          hidden.at<uchar>(v, u) = 1;
+        }
+      }
+    }
+    cv::Mat near_hidden;
+    cv::dilate(hidden, near_hidden, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(21, 21)));
+    for (int v = 0; v < rendered.depth.rows; ++v) {
+      for (int u = 0; u < rendered.depth.cols; ++u) {
+        if (hidden.at<uchar>(v, u) != 0 || (frame.depth.at<float>(v, u) <= 0.0F && near_hidden.at<uchar>(v, u) != 0)) {
           rendered.mask.at<uchar>(v, u) = 0;
           rendered.labels.at<uint16_t>(v, u) = 0;
         }

@@ -58,12 +58,11 @@ TEST_F(RecognizeEndToEnd, FindsTheObjectsOfTheDemoFrameWithinTenthOfTheirDiamete
   EXPECT_EQ(evaluation.false_positives, 0) << run.output;
   int correct = 0;
   for (const ObjectEvaluation& object : evaluation.objects) {
-    if (object.model == "003_cracker_box" || object.model == "006_mustard_bottle") {
-      EXPECT_TRUE(object.correct) << object.model << ": ADD " << object.error.add_m << " m\n" << run.output;
-    }
+    // All three, the sugar box half hidden behind the mustard bottle included (since 5 views per model).
+    EXPECT_TRUE(object.correct) << object.model << ": ADD " << object.error.add_m << " m\n" << run.output;
     correct += object.correct ? 1 : 0;
   }
-  EXPECT_GE(correct, 2);
+  EXPECT_EQ(correct, 3);
   EXPECT_EQ(ReadColorImage(directory_->File("detections.png")).size(), frame.rgbd.color.size());
 
   // The eval command agrees and prints the table.
