@@ -213,7 +213,14 @@ class Estimator {
     const double fraction = options_.required_inlier_fraction;
     const double spread = 3.0 * std::sqrt(fraction * (1.0 - fraction));  // 3 sigma of the binomial, per sqrt(k)
     size_t checked = 0;                                                  // visible object points so far
+    size_t remaining = order_.size();                                    // points not looked at yet
     for (const int index : order_) {
+      // Lost even if every remaining point were a visible inlier: (inliers + r) / (checked + r) < fraction.
+      if (static_cast<double>(inliers->object.size() + remaining) <
+          fraction * static_cast<double>(checked + remaining)) {
+        return false;
+      }
+      --remaining;
       const Eigen::Vector3f& point = object_[static_cast<size_t>(index)];
       const Eigen::Vector3f moved = transform * point;
       if (visibility_ != nullptr && !Visible(*visibility_, moved)) continue;
