@@ -239,10 +239,17 @@ NamedFrame ObjectPixelsOnly(const NamedFrame& frame, const std::vector<PeerModel
 const char* kPcl = "PCL FPFH + prerejective + ICP";
 const char* kPpf = "OpenCV PPF + ICP";
 
-// Ours with and without ICP and, with `peers`, both peers, on `frames` with the library at `db`.
-// With `track`, also ours with the previous frame's detections as priors (Recognizer::Recognize with priors).
-Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, bool peers, bool ours, bool object_pixels,
-            bool track, const PeerOptions& peer_options, std::ostringstream* notes) {
+// Which methods RunAll runs.
+struct Methods {
+  bool ours = true;            ///< ECV with and without ICP
+  bool track = false;          ///< ours also with the previous frame's detections as priors
+  bool peers = false;          ///< PCL and OpenCV PPF on the whole frames
+  bool object_pixels = false;  ///< the peers also on the objects' pixels only
+};
+
+// The `methods` on `frames` with the library at `db`.
+Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const Methods& methods,
+            const PeerOptions& peer_options, std::ostringstream* notes) {
   LibraryLoadOptions load;
   load.build_matchers = false;
   const ModelLibrary library = ModelLibrary::Load(db, load);
@@ -255,15 +262,15 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, bool p
          << ". ";
   Runs runs;
   RecognizerOptions options;
-  if (ours) {
+  if (methods.ours) {
     runs.emplace_back("ECV + RANSAC + ICP", RunRecognizer(library, options, frames, models, "icp"));
-    if (track) {
+    if (methods.track) {
       runs.emplace_back("ECV + RANSAC + ICP, tracking", RunRecognizer(library, options, frames, models, "track", true));
     }
     options.refine = false;
     runs.emplace_back("ECV + RANSAC (no ICP)", RunRecognizer(library, options, frames, models, "no icp"));
   }
-  if (!peers) return runs;
+  if (!methods.peers) return runs;
   std::vector<PeerModel> peer_models;
   for (const LibraryModel& model : library.models()) peer_models.push_back(SamplePeerModel(model.record));
   *notes << GroundTruthInlierShares(peer_models, frames, peer_options);
@@ -275,13 +282,13 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, bool p
   const std::unique_ptr<RecognitionPeer> ppf = MakePpfPeer(peer_models, peer_options);
   const double ppf_setup_ms = MillisecondsSince(start);
   runs.emplace_back(kPpf, RunPeer(*ppf, frames, models, "ppf"));
-  if (object_pixels) {
+  if (methods.object_pixels) {
     std::vector<NamedFrame> masked;
     for (const NamedFrame& frame : frames) masked.push_back(ObjectPixelsOnly(frame, peer_models));
     runs.emplace_back(std::string(kPcl) + ", objects' pixels only", RunPeer(*pcl, masked, models, "pcl objects"));
     runs.emplace_back(std::string(kPpf) + ", objects' pixels only", RunPeer(*ppf, masked, models, "ppf objects"));
   }
-  const size_t first_peer = ours ? (track ? 3 : 2) : 0;
+  const size_t first_peer = methods.ours ? (methods.track ? 3 : 2) : 0;
   const Run& pcl_run = runs[first_peer].second;
   const Run& ppf_run = runs[first_peer + 1].second;
   *notes << "Peers: model set-up (voxel grid, PCL normals + FPFH) " << Fixed(pcl_setup_ms, 0)
@@ -328,19 +335,19 @@ int main(int argc, char** argv) {
   using namespace ecv::bench;
   std::string db, lmo_db, results = std::string(ECV_SOURCE_DIR) + "/bench/RESULTS.md";
   int limit = 0, step = 1;
-  bool peers = false, ours = true, object_pixels = false, track = false;
+  Methods methods;
   PeerOptions peer_options;
   for (int i = 1; i < argc; ++i) {
     const bool has_value = i + 1 < argc;
     if (std::strcmp(argv[i], "--peers") == 0) {
-      peers = true;
+      methods.peers = true;
     } else if (std::strcmp(argv[i], "--peers-only") == 0) {  // for tuning the peers
-      peers = true;
-      ours = false;
-    } else if (std::strcmp(argv[i], "--object-pixels") == 0) {  // peers also on the objects' pixels only
-      object_pixels = true;
-    } else if (std::strcmp(argv[i], "--track") == 0) {  // ours also with the previous frame's detections
-      track = true;
+      methods.peers = true;
+      methods.ours = false;
+    } else if (std::strcmp(argv[i], "--object-pixels") == 0) {
+      methods.object_pixels = true;
+    } else if (std::strcmp(argv[i], "--track") == 0) {
+      methods.track = true;
     } else if (has_value && std::strcmp(argv[i], "--frame-step") == 0) {
       step = std::atoi(argv[++i]);
     } else if (has_value && std::strcmp(argv[i], "--ppf-sampling") == 0) {
@@ -376,28 +383,29 @@ int main(int argc, char** argv) {
     peer_options.Check();
     std::ostringstream markdown, notes;
     const std::vector<NamedFrame> frames = YcbvFrames(ECV_DATA_DIR, limit, step);
-    const Runs runs = RunAll(db, frames, peers, ours, object_pixels, track, peer_options, &notes);
+    const Runs runs = RunAll(db, frames, methods, peer_options, &notes);
     markdown << notes.str() << frames.size()
              << " YCB-Video frames (videos 0000-0002). Correct = ADD < 0.1 x diameter (ADD-S for symmetric models); "
                 "a false positive is a detection of a model not in the frame or a wrong pose.\n\n"
              << RecallTable(runs);
-    if (ours)
+    if (methods.ours)
       markdown << "\nTime per frame, whole library (ECV + RANSAC + ICP):\n\n" << TimingTable(runs.front().second);
-    if (ours && track) {
+    if (methods.ours && methods.track) {
       markdown << "\nThe same with tracking (each frame gets the previous frame's detections of its video as priors; "
                   "the first frame of each video has none):\n\n"
                << TimingTable(runs[1].second);
     }
     if (!lmo_db.empty()) {
       std::ostringstream lmo_notes;
-      const Runs lmo_runs =
-          RunAll(lmo_db, LmoFrames(ECV_DATA_DIR), peers, ours, object_pixels, false, peer_options, &lmo_notes);
+      Methods lmo_methods = methods;
+      lmo_methods.track = false;  // one frame
+      const Runs lmo_runs = RunAll(lmo_db, LmoFrames(ECV_DATA_DIR), lmo_methods, peer_options, &lmo_notes);
       markdown << "\nLinemod-Occluded, scene 000002 image 3 (Kinect v1, 8 vertex-coloured models, eggbox and glue "
                   "judged by ADD-S). "
                << lmo_notes.str() << "\n\n"
                << RecallTable(lmo_runs);
     }
-    if (peers) markdown << '\n' << PeerSettings(peer_options);
+    if (methods.peers) markdown << '\n' << PeerSettings(peer_options);
     Report(results, "Recognition on YCB-Video and LM-O (recognize_bench)", CommandLine(argc, argv), markdown.str());
   } catch (const std::exception& error) {
     std::cerr << "recognize_bench: " << error.what() << '\n';

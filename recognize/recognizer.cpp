@@ -108,6 +108,7 @@ void RecognizerOptions::Check() const {
   };
   require(views_per_model >= 1, "views_per_model", "at least 1");
   consistency.Check();
+  plane_patch.Check();
   require(consistency_max_correspondences >= 3, "consistency_max_correspondences", "at least 3");
   require(dense_stride_px >= 1, "dense_stride_px", "at least 1");
   require(sample_radius_diameters >= 0.0, "sample_radius_diameters", ">= 0 (0: sample anywhere)");
@@ -469,7 +470,37 @@ class Recognizer::Impl {
     detection.visible_fraction = rendered_pixels > 0 ? static_cast<double>(visible) / rendered_pixels : 0.0;
     detection.depth_agreement = visible > 0 ? static_cast<double>(on_surface) / visible : 0.0;
     detection.score = detection.depth_agreement * detection.color_agreement;
+    if (options_.reject_plane_patches && detection.score > 0.0 &&
+        OnLargerPlane(frame, rendered.depth, verified.surface)) {
+      detection.score = 0.0;
+    }
     return verified;
+  }
+
+  // PatchOfLargerPlane for a rendered pose: its surface pixels against the scene points of a ring of
+  // kPlaneRingSamples samples (at dense_stride_px) around its silhouette.
+  bool OnLargerPlane(const RgbdFrame& frame, const cv::Mat& rendered_depth,
+                     const std::vector<cv::Point>& surface) const {
+    constexpr int kPlaneRingSamples = 3;
+    const int stride = options_.dense_stride_px;
+    auto scene_point = [&](int u, int v) -> Eigen::Vector3f {
+      return frame.camera.BackProject({u, v}, frame.depth.at<float>(v, u)).cast<float>();
+    };
+    std::vector<Eigen::Vector3f> surface_points, ring_points;
+    for (const cv::Point& p : surface) surface_points.push_back(scene_point(p.x, p.y));
+    const cv::Mat silhouette = rendered_depth > 0.0F;
+    cv::Mat grown;
+    cv::dilate(
+        silhouette, grown,
+        cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * kPlaneRingSamples + 1, 2 * kPlaneRingSamples + 1)));
+    for (int v = 0; v < grown.rows; ++v) {
+      for (int u = 0; u < grown.cols; ++u) {
+        if (grown.at<uchar>(v, u) == 0 || silhouette.at<uchar>(v, u) != 0) continue;
+        if (frame.depth.at<float>(v * stride, u * stride) > 0.0F)
+          ring_points.push_back(scene_point(u * stride, v * stride));
+      }
+    }
+    return PatchOfLargerPlane(surface_points, ring_points, options_.plane_patch);
   }
 
  public:

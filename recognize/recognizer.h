@@ -73,6 +73,12 @@ struct RecognizerOptions {
   /// 0.35 found 68 at 0.03, 0.4 found 59 at 0.03.
   double min_track_start_score = 0.35;
   double min_visible_fraction = 0.1;  ///< of the model's rendered pixels that the scene can show
+  /// A pose whose surface pixels are one patch of a larger scene plane (PatchOfLargerPlane: the plane goes on
+  /// around the silhouette) scores 0: the depth shows nothing of the object there. On video 0002 it was a
+  /// tomato soup can sunk into the table, its lid flush with the table top (depth agreement 1.0), tracked
+  /// for 8 frames.
+  bool reject_plane_patches = true;
+  PlanePatchOptions plane_patch;
   /// A detection whose surface pixels (rendered on the scene surface) lie on more than this share of pixels
   /// that a better-scored detection of another model explains is dropped: one surface, one object.
   double max_overlap = 0.3;

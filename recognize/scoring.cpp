@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numeric>
 
+#include <Eigen/Eigenvalues>
+
 #include "core/error.h"
 
 namespace ecv {
@@ -87,6 +89,39 @@ int ConsistentSetSize(const std::vector<Primitive>& object, const std::vector<Pr
     best = std::max(best, static_cast<int>(set.size()) + 1);
   }
   return best;
+}
+
+void PlanePatchOptions::Check() const {
+  auto require = [](bool ok, const char* field, const char* expected) {
+    if (!ok) ThrowInputError("plane patch options", field, expected);
+  };
+  require(distance_m > 0.0, "distance_m", "> 0 m");
+  require(min_share > 0.0 && min_share <= 1.0, "min_share", "in (0, 1]");
+  require(min_points >= 3, "min_points", "at least 3");
+}
+
+bool PatchOfLargerPlane(const std::vector<Eigen::Vector3f>& surface, const std::vector<Eigen::Vector3f>& ring,
+                        const PlanePatchOptions& options) {
+  options.Check();
+  const auto min_points = static_cast<size_t>(options.min_points);
+  if (surface.size() < min_points || ring.size() < min_points) return false;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3f& point : surface) mean += point.cast<double>();
+  mean /= static_cast<double>(surface.size());
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (const Eigen::Vector3f& point : surface) {
+    const Eigen::Vector3d offset = point.cast<double>() - mean;
+    covariance += offset * offset.transpose();
+  }
+  covariance /= static_cast<double>(surface.size());
+  const Eigen::Vector3d normal = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvectors().col(0);
+  auto mostly_on_plane = [&](const std::vector<Eigen::Vector3f>& points) {
+    const auto on_plane = std::count_if(points.begin(), points.end(), [&](const Eigen::Vector3f& point) {
+      return std::abs((point.cast<double>() - mean).dot(normal)) <= options.distance_m;
+    });
+    return static_cast<double>(on_plane) >= options.min_share * static_cast<double>(points.size());
+  };
+  return mostly_on_plane(surface) && mostly_on_plane(ring);
 }
 
 // Normalised cross-correlation of (model, scene) colour pairs, per channel, averaged and clipped to [0, 1]:

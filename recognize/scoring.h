@@ -34,6 +34,23 @@ struct ConsistencyOptions {
 int ConsistentSetSize(const std::vector<Primitive>& object, const std::vector<Primitive>& scene,
                       const std::vector<Correspondence>& correspondences, const ConsistencyOptions& options = {});
 
+/// When a pose only explains a patch of a larger plane (see PatchOfLargerPlane).
+struct PlanePatchOptions {
+  double distance_m = 0.01;  ///< a point lies on the surface points' plane (least squares) within this, metres
+  double min_share = 0.8;    ///< the surface is planar, and the ring on its plane, when this share of them is
+  int min_points = 20;       ///< fewer surface or ring points decide nothing (false)
+
+  /// Throws InputError on values outside their ranges.
+  void Check() const;
+};
+
+/// Whether `surface` (scene points where a posed model lies on the scene) lies on one plane and most of `ring`
+/// (scene points just outside the model's silhouette) lies on that plane too. The depth then shows nothing of
+/// the object: e.g. a can sunk into a table with its lid flush with the table top, which fits the depth
+/// perfectly. A box face seen head-on is not such a patch: the scene around it lies elsewhere.
+bool PatchOfLargerPlane(const std::vector<Eigen::Vector3f>& surface, const std::vector<Eigen::Vector3f>& ring,
+                        const PlanePatchOptions& options = {});
+
 /// Normalised cross-correlation of (model, scene) colour pairs, per channel, averaged and clipped to [0, 1];
 /// 0 for fewer than 10 pairs. High when the model's texture lies where the scene shows it, whatever the
 /// gain and offset of the light.

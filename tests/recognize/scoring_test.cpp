@@ -1,6 +1,7 @@
 // The recognizer's scores on constructed data: the consistent-set size of planted true correspondences
 // among false ones, and the colour correlation's invariance to gain and offset.
 
+#include <cmath>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -125,6 +126,45 @@ TEST(ColorCorrelation, IsNearZeroForUnrelatedColoursAndZeroWhenInverted) {
   for (auto& [model, scene] : inverted) scene = Eigen::Vector3f::Ones() - model;
   EXPECT_EQ(ColorCorrelation(inverted), 0.0);
   EXPECT_EQ(ColorCorrelation(Colors(9, 5)), 0.0);  // too few pairs to say
+}
+
+// Points on the plane z = 0.8 + slope * x (camera frame, metres) with 3 mm noise: a disc of radius 3 cm about
+// (0, 0) when `disc`, else a ring from 3.5 to 6 cm.
+std::vector<Eigen::Vector3f> PlanePoints(bool disc, float slope, float offset, unsigned seed) {
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<float> coordinate(-0.06F, 0.06F);
+  std::normal_distribution<float> noise(0.0F, 0.003F);
+  std::vector<Eigen::Vector3f> points;
+  while (points.size() < 300) {
+    const float x = coordinate(random), y = coordinate(random), r = std::hypot(x, y);
+    if (disc ? r > 0.03F : (r < 0.035F || r > 0.06F)) continue;
+    points.emplace_back(x, y, 0.8F + slope * x + offset + noise(random));
+  }
+  return points;
+}
+
+TEST(PatchOfLargerPlane, AFlatSurfaceWhosePlaneGoesOnAroundItIsAPatch) {
+  // A can sunk into a tilted table, its lid flush with the table top.
+  EXPECT_TRUE(PatchOfLargerPlane(PlanePoints(true, 0.5F, 0.0F, 1), PlanePoints(false, 0.5F, 0.0F, 2)));
+}
+
+TEST(PatchOfLargerPlane, AFaceAboveItsSurroundingsOrACurvedSurfaceIsNot) {
+  // A box's top face 3 cm above the table around it.
+  EXPECT_FALSE(PatchOfLargerPlane(PlanePoints(true, 0.5F, -0.03F, 1), PlanePoints(false, 0.5F, 0.0F, 2)));
+  // A curved surface (a can's side) on the table: the surface is not one plane.
+  std::vector<Eigen::Vector3f> side;
+  for (int i = 0; i < 300; ++i) {
+    const float angle = static_cast<float>(i) * 0.01F;
+    side.emplace_back(0.033F * std::sin(angle), 0.0002F * static_cast<float>(i % 50), 0.8F - 0.033F * std::cos(angle));
+  }
+  EXPECT_FALSE(PatchOfLargerPlane(side, PlanePoints(false, 0.0F, 0.0F, 2)));
+  // Too few points to say.
+  std::vector<Eigen::Vector3f> few = PlanePoints(true, 0.0F, 0.0F, 1);
+  few.resize(10);
+  EXPECT_FALSE(PatchOfLargerPlane(few, PlanePoints(false, 0.0F, 0.0F, 2)));
+  PlanePatchOptions bad;
+  bad.min_share = 0.0;
+  EXPECT_THROW(PatchOfLargerPlane(side, side, bad), InputError);
 }
 
 }  // namespace
