@@ -151,20 +151,17 @@ TEST(PatchOfLargerPlane, AFlatSurfaceWhosePlaneGoesOnAroundItIsAPatch) {
 TEST(PatchOfLargerPlane, AFaceAboveItsSurroundingsOrACurvedSurfaceIsNot) {
   // A box's top face 3 cm above the table around it.
   EXPECT_FALSE(PatchOfLargerPlane(PlanePoints(true, 0.5F, -0.03F, 1), PlanePoints(false, 0.5F, 0.0F, 2)));
-  // A curved surface (a can's side) on the table: the surface is not one plane.
-  std::vector<Eigen::Vector3f> side;
-  for (int i = 0; i < 300; ++i) {
-    const float angle = static_cast<float>(i) * 0.01F;
-    side.emplace_back(0.033F * std::sin(angle), 0.0002F * static_cast<float>(i % 50), 0.8F - 0.033F * std::cos(angle));
-  }
-  EXPECT_FALSE(PatchOfLargerPlane(side, PlanePoints(false, 0.0F, 0.0F, 2)));
+  // A corrugated surface (1.5 cm waves) whose least-squares plane is the table's: not one plane.
+  std::vector<Eigen::Vector3f> waves = PlanePoints(true, 0.0F, 0.0F, 1);
+  for (Eigen::Vector3f& point : waves) point.z() += 0.015F * std::cos(point.x() * 300.0F);
+  EXPECT_FALSE(PatchOfLargerPlane(waves, PlanePoints(false, 0.0F, 0.0F, 2)));
   // Too few points to say.
   std::vector<Eigen::Vector3f> few = PlanePoints(true, 0.0F, 0.0F, 1);
   few.resize(10);
   EXPECT_FALSE(PatchOfLargerPlane(few, PlanePoints(false, 0.0F, 0.0F, 2)));
   PlanePatchOptions bad;
   bad.min_share = 0.0;
-  EXPECT_THROW(PatchOfLargerPlane(side, side, bad), InputError);
+  EXPECT_THROW(PatchOfLargerPlane(waves, waves, bad), InputError);
 }
 
 }  // namespace
