@@ -4,9 +4,8 @@
 #include <cmath>
 #include <numeric>
 
-#include <Eigen/Eigenvalues>
-
 #include "core/error.h"
+#include "ecv/surface.h"
 
 namespace ecv {
 namespace {
@@ -105,19 +104,10 @@ bool PatchOfLargerPlane(const std::vector<Eigen::Vector3f>& surface, const std::
   options.Check();
   const auto min_points = static_cast<size_t>(options.min_points);
   if (surface.size() < min_points || ring.size() < min_points) return false;
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3f& point : surface) mean += point.cast<double>();
-  mean /= static_cast<double>(surface.size());
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  for (const Eigen::Vector3f& point : surface) {
-    const Eigen::Vector3d offset = point.cast<double>() - mean;
-    covariance += offset * offset.transpose();
-  }
-  covariance /= static_cast<double>(surface.size());
-  const Eigen::Vector3d normal = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvectors().col(0);
+  const Plane plane = FitPlane(surface);
   auto mostly_on_plane = [&](const std::vector<Eigen::Vector3f>& points) {
     const auto on_plane = std::count_if(points.begin(), points.end(), [&](const Eigen::Vector3f& point) {
-      return std::abs((point.cast<double>() - mean).dot(normal)) <= options.distance_m;
+      return std::abs((point - plane.centroid).dot(plane.normal)) <= options.distance_m;
     });
     return static_cast<double>(on_plane) >= options.min_share * static_cast<double>(points.size());
   };

@@ -14,15 +14,9 @@ constexpr int kDepthWindow = 2;      // FrontSurfaceDepth looks at a (2k+1)^2 wi
 constexpr int kMaxPlaneWindow = 24;  // pixels; bounds the plane-fit window at close range
 constexpr int kMinPlanePoints = 6;
 
-// Unit plane normal of `points` (smallest principal axis), facing the camera at the origin.
+// Unit plane normal of `points`, facing the camera at the origin.
 Eigen::Vector3f FitNormal(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& towards) {
-  Eigen::Vector3f mean = Eigen::Vector3f::Zero();
-  for (const Eigen::Vector3f& p : points) mean += p;
-  mean /= static_cast<float>(points.size());
-  Eigen::Matrix3f covariance = Eigen::Matrix3f::Zero();
-  for (const Eigen::Vector3f& p : points) covariance += (p - mean) * (p - mean).transpose();
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3f> solver(covariance);
-  Eigen::Vector3f normal = solver.eigenvectors().col(0).normalized();
+  Eigen::Vector3f normal = FitPlane(points).normal;
   if (normal.dot(towards) > 0.0F) normal = -normal;
   return normal;
 }
@@ -32,6 +26,17 @@ Eigen::Vector3f Ray(const PinholeCamera& camera, const Eigen::Vector2f& pixel) {
 }
 
 }  // namespace
+
+Plane FitPlane(const std::vector<Eigen::Vector3f>& points) {
+  Plane plane;
+  for (const Eigen::Vector3f& p : points) plane.centroid += p;
+  plane.centroid /= static_cast<float>(points.size());
+  Eigen::Matrix3f covariance = Eigen::Matrix3f::Zero();
+  for (const Eigen::Vector3f& p : points) covariance += (p - plane.centroid) * (p - plane.centroid).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3f> solver(covariance);
+  plane.normal = solver.eigenvectors().col(0).normalized();
+  return plane;
+}
 
 std::optional<float> FrontSurfaceDepth(const cv::Mat& depth, const cv::Point& pixel, double depth_gap_m) {
   float values[(2 * kDepthWindow + 1) * (2 * kDepthWindow + 1)];

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <optional>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -14,6 +15,15 @@ struct LocalSurface {
   Eigen::Vector3f normal;    ///< unit, facing the camera; zero when too few points to fit a plane
   Eigen::Vector3f color;     ///< mean RGB in [0, 1] around the keypoint on this surface
 };
+
+/// A least-squares plane: the points' centroid and unit normal (smallest principal axis, sign arbitrary).
+struct Plane {
+  Eigen::Vector3f centroid = Eigen::Vector3f::Zero();
+  Eigen::Vector3f normal = Eigen::Vector3f::UnitZ();
+};
+
+/// The least-squares plane of `points` (at least 3).
+Plane FitPlane(const std::vector<Eigen::Vector3f>& points);
 
 /// Options of the reconstruction (a subset of EcvOptions).
 struct SurfaceOptions {
