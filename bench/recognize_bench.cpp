@@ -6,8 +6,9 @@
 //
 //   scripts/build_ycbv_library /tmp/ycbv.sqlite --views 40 --distance 0.9
 //   scripts/build_lmo_library /tmp/lmo.sqlite --views 40 --distance 1.0
-//   recognize_bench --db /tmp/ycbv.sqlite [--lmo-db /tmp/lmo.sqlite] [--peers] [--results bench/RESULTS.md]
-//                   [--frames N]
+//   recognize_bench --db /tmp/ycbv.sqlite [--lmo-db /tmp/lmo.sqlite] [--peers] [--track] [--threads N]
+//                   [--results bench/RESULTS.md] [--frames N]
+// --threads N (N > 1) adds a run of ours with N worker threads: the same detections (checked), its own times.
 // --object-pixels also runs the peers on depth cut to the ground-truth objects' own pixels; --peers-only,
 // --frame-step, --ppf-sampling, --ppf-scene-distance and --min-inlier-fraction are for tuning the peers.
 
@@ -76,6 +77,22 @@ void Log(const std::string& label, size_t i, size_t n, const FrameEvaluation& ev
   std::cerr << label << " [" << i + 1 << "/" << n << "] " << evaluation.frame << ": " << correct << " of "
             << evaluation.objects.size() << " correct, " << evaluation.false_positives << " false positives, "
             << Fixed(ms, 0) << " ms\n";
+}
+
+// Whether two runs judged the same detections: per frame, the same objects found with the same pose errors and
+// the same false positives.
+bool SameDetections(const Run& a, const Run& b) {
+  if (a.frames.size() != b.frames.size()) return false;
+  for (size_t f = 0; f < a.frames.size(); ++f) {
+    const FrameEvaluation &x = a.frames[f], &y = b.frames[f];
+    if (x.objects.size() != y.objects.size() || x.false_positive_models != y.false_positive_models) return false;
+    for (size_t o = 0; o < x.objects.size(); ++o) {
+      if (x.objects[o].detected != y.objects[o].detected || x.objects[o].error.add_m != y.objects[o].error.add_m) {
+        return false;
+      }
+    }
+  }
+  return true;
 }
 
 // With `track`, each frame gets the previous frame's detections of the same video as priors.
@@ -245,6 +262,7 @@ struct Methods {
   bool track = false;          ///< ours also with the previous frame's detections as priors
   bool peers = false;          ///< PCL and OpenCV PPF on the whole frames
   bool object_pixels = false;  ///< the peers also on the objects' pixels only
+  int threads = 1;             ///< > 1: ours also with this many worker threads (the same detections, faster)
 };
 
 // The `methods` on `frames` with the library at `db`.
@@ -264,6 +282,14 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
   RecognizerOptions options;
   if (methods.ours) {
     runs.emplace_back("ECV + RANSAC + ICP", RunRecognizer(library, options, frames, models, "icp"));
+    if (methods.threads > 1) {
+      RecognizerOptions threaded = options;
+      threaded.ransac.threads = methods.threads;
+      const std::string label = "ECV + RANSAC + ICP, " + std::to_string(methods.threads) + " threads";
+      runs.emplace_back(label, RunRecognizer(library, threaded, frames, models, "threads"));
+      *notes << label << ": detections " << (SameDetections(runs.front().second, runs.back().second) ? "" : "NOT ")
+             << "identical to one thread's. ";
+    }
     if (methods.track) {
       runs.emplace_back("ECV + RANSAC + ICP, tracking", RunRecognizer(library, options, frames, models, "track", true));
     }
@@ -288,9 +314,11 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
     runs.emplace_back(std::string(kPcl) + ", objects' pixels only", RunPeer(*pcl, masked, models, "pcl objects"));
     runs.emplace_back(std::string(kPpf) + ", objects' pixels only", RunPeer(*ppf, masked, models, "ppf objects"));
   }
-  const size_t first_peer = methods.ours ? (methods.track ? 3 : 2) : 0;
-  const Run& pcl_run = runs[first_peer].second;
-  const Run& ppf_run = runs[first_peer + 1].second;
+  const auto run_named = [&](const std::string& name) -> const Run& {
+    return std::find_if(runs.begin(), runs.end(), [&](const auto& run) { return run.first == name; })->second;
+  };
+  const Run& pcl_run = run_named(kPcl);
+  const Run& ppf_run = run_named(kPpf);
   *notes << "Peers: model set-up (voxel grid, PCL normals + FPFH) " << Fixed(pcl_setup_ms, 0)
          << " ms for PCL, PPF training " << Fixed(ppf_setup_ms, 0) << " ms for OpenCV, not in the times per frame; "
          << "scene cloud " << Fixed(Median(pcl_run.stage_ms.at("scene points")), 0)
@@ -346,6 +374,12 @@ int main(int argc, char** argv) {
       methods.ours = false;
     } else if (std::strcmp(argv[i], "--object-pixels") == 0) {
       methods.object_pixels = true;
+    } else if (has_value && std::strcmp(argv[i], "--threads") == 0) {
+      methods.threads = std::atoi(argv[++i]);
+      if (methods.threads < 1) {
+        db.clear();
+        break;
+      }
     } else if (std::strcmp(argv[i], "--track") == 0) {
       methods.track = true;
     } else if (has_value && std::strcmp(argv[i], "--frame-step") == 0) {
@@ -372,7 +406,7 @@ int main(int argc, char** argv) {
   if (db.empty()) {
     std::cerr
         << "usage: recognize_bench --db LIB.sqlite [--lmo-db LMO.sqlite] [--peers | --peers-only] [--object-pixels]\n"
-           "         [--track]\n"
+           "         [--track] [--threads N]\n"
            "         [--results FILE] [--frames N] [--frame-step S] [--ppf-sampling R] [--ppf-scene-distance R]\n"
            "         [--min-inlier-fraction F]\n"
            "  (build the libraries with scripts/build_ycbv_library LIB.sqlite --views 40 --distance 0.9 and\n"
