@@ -253,7 +253,7 @@ class Recognizer::Impl {
         (describe.max_neighbours == 0 || describe.max_neighbours > options_.scene_max_neighbours)) {
       describe.max_neighbours = options_.scene_max_neighbours;
     }
-    scene->descriptors = ComputeDescriptors(scene->primitives, describe);
+    scene->descriptors = ComputeDescriptors(scene->primitives, describe, options_.ransac.threads);
     if (scene->descriptors.values.rows > 0) {
       scene->matcher = std::make_unique<DescriptorMatcher>(scene->primitives, scene->descriptors, options_.match);
     }

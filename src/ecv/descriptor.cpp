@@ -1,9 +1,11 @@
 #include "ecv/descriptor.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <numeric>
 #include <string>
+#include <thread>
 
 #include <flann/algorithms/dist.h>
 #include <flann/algorithms/kdtree_single_index.h>
@@ -172,8 +174,9 @@ void DescriptorOptions::Check() const {
   }
 }
 
-Descriptors ComputeDescriptors(const std::vector<Primitive>& input, const DescriptorOptions& options) {
+Descriptors ComputeDescriptors(const std::vector<Primitive>& input, const DescriptorOptions& options, int threads) {
   options.Check();
+  if (threads < 1) ThrowInputError("descriptor computation", "threads", "at least 1", std::to_string(threads));
   const std::vector<Primitive> balanced =
       options.balance_colors && !input.empty() ? BalanceColors(input) : std::vector<Primitive>();
   const std::vector<Primitive>& primitives = options.balance_colors ? balanced : input;
@@ -197,26 +200,40 @@ Descriptors ComputeDescriptors(const std::vector<Primitive>& input, const Descri
 
   const AppearanceValues appearance = ComputeAppearance(primitives, options.appearance);
   const Context context{primitives, appearance, options};
+  // Row i describes primitive i; the rows of isolated primitives are dropped at the end.
   cv::Mat values(static_cast<int>(primitives.size()), kDescriptorSize, CV_32F);
-  std::vector<int> neighbours;
-  std::vector<float> neighbour_distances;
-  for (size_t i = 0; i < primitives.size(); ++i) {
-    if (neighbour_lists[i].size() < 2) continue;            // isolated: no context
+  auto describe = [&](size_t i) {
     const std::vector<size_t>& found = neighbour_lists[i];  // by distance, the source first
     const size_t cap = options.max_neighbours > 0 ? static_cast<size_t>(options.max_neighbours) : found.size();
-    neighbours.clear();
-    neighbour_distances.clear();
+    std::vector<int> neighbours;
+    std::vector<float> neighbour_distances;
     for (size_t j = 0; j < std::min(cap, found.size()); ++j) {
       // All, or evenly spread over the distance ranks, so that the context still spans the whole radius.
       const size_t k = found.size() <= cap ? j : j * (found.size() - 1) / (cap - 1);
       neighbours.push_back(static_cast<int>(found[k]));
       neighbour_distances.push_back(std::sqrt(distances[i][k]));
     }
-    float* row = values.ptr<float>(static_cast<int>(descriptors.primitive.size()));
-    DescribeContext(context, static_cast<int>(i), neighbours, neighbour_distances, row);
-    descriptors.primitive.push_back(static_cast<int>(i));
+    DescribeContext(context, static_cast<int>(i), neighbours, neighbour_distances,
+                    values.ptr<float>(static_cast<int>(i)));
+  };
+  std::atomic<size_t> next{0};
+  auto work = [&] {
+    for (size_t i = next++; i < primitives.size(); i = next++) {
+      if (neighbour_lists[i].size() >= 2) describe(i);  // isolated: no context
+    }
+  };
+  std::vector<std::thread> workers;
+  for (int t = 1; t < threads; ++t) workers.emplace_back(work);
+  work();
+  for (std::thread& worker : workers) worker.join();
+
+  for (size_t i = 0; i < primitives.size(); ++i) {
+    if (neighbour_lists[i].size() >= 2) descriptors.primitive.push_back(static_cast<int>(i));
   }
-  descriptors.values = values.rowRange(0, static_cast<int>(descriptors.primitive.size())).clone();
+  descriptors.values.create(static_cast<int>(descriptors.primitive.size()), kDescriptorSize, CV_32F);
+  for (size_t row = 0; row < descriptors.primitive.size(); ++row) {
+    values.row(descriptors.primitive[row]).copyTo(descriptors.values.row(static_cast<int>(row)));
+  }
   return descriptors;
 }
 

@@ -88,6 +88,8 @@ struct Descriptors {
 /// values (R_Ak = c_b[k] - c_a[k] in the paper; see DescriptorAppearance) to six 16-bin histograms over
 /// [-1, 1] (over [0, 1] for unsigned cosines), each normalised to sum 1. Neighbours of both types form
 /// the context.
-Descriptors ComputeDescriptors(const std::vector<Primitive>& primitives, const DescriptorOptions& options = {});
+/// `threads` worker threads share the primitives out; the result does not depend on their number.
+Descriptors ComputeDescriptors(const std::vector<Primitive>& primitives, const DescriptorOptions& options = {},
+                               int threads = 1);
 
 }  // namespace ecv

@@ -1,10 +1,12 @@
 // ECV context descriptors and their matching: invariance, normalisation, constructed matches, and the
 // correspondence score of a real view against itself.
 
+#include <algorithm>
 #include <random>
 
 #include <gtest/gtest.h>
 
+#include "core/error.h"
 #include "ecv/descriptor.h"
 #include "ecv/matching.h"
 #include "io/frame_io.h"
@@ -129,6 +131,21 @@ TEST(EcvDescriptor, VariantsInvariantToRigidMotionAndNormalised) {
       }
     }
   }
+}
+
+TEST(EcvDescriptor, SameDescriptorsWithAnyNumberOfThreads) {
+  std::vector<Primitive> primitives = RandomPrimitives(500, 7);
+  primitives[3].position = {1.0F, 1.0F, 1.0F};  // isolated: its row is dropped whatever the thread that saw it
+  for (const auto& [name, options] : Variants()) {
+    const Descriptors serial = ComputeDescriptors(primitives, options);
+    ASSERT_EQ(std::count(serial.primitive.begin(), serial.primitive.end(), 3), 0) << name;
+    for (const int threads : {2, 3, 8}) {
+      const Descriptors threaded = ComputeDescriptors(primitives, options, threads);
+      ASSERT_EQ(threaded.primitive, serial.primitive) << name << ", " << threads << " threads";
+      EXPECT_EQ(cv::norm(threaded.values, serial.values, cv::NORM_INF), 0.0) << name << ", " << threads << " threads";
+    }
+  }
+  EXPECT_THROW(ComputeDescriptors(primitives, {}, 0), InputError);
 }
 
 TEST(EcvDescriptor, IsolatedPrimitivesGetNone) {
