@@ -136,7 +136,7 @@ Eigen::Isometry3d PoseInFrame(const ColorcalArgs& args, const LoadedFrame& frame
 
 // Automatic pairs of the model in one frame: rendered at the pose, paired where the depths agree.
 std::vector<ColorPair> PairsInFrame(const ColorcalArgs& args, const FrameSpec& spec, Renderer& renderer, MeshId id) {
-  const LoadedFrame frame = LoadFrame(spec);
+  const LoadedFrame frame = app::LoadFrameWithWarnings(spec);
   const std::string frame_name = FrameName(spec);
   const Eigen::Isometry3d camera_from_object = PoseInFrame(args, frame, frame_name);
   RenderOptions render_options;

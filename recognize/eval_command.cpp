@@ -39,7 +39,7 @@ std::vector<FrameEvaluation> EvaluateOneFrame(const EvalArgs& args, const std::v
                       "a model of the library " + args.db, "'" + detections[i].model + "'");
     }
   }
-  const LoadedFrame frame = LoadFrame(args.frame);
+  const LoadedFrame frame = app::LoadFrameWithWarnings(args.frame);
   if (frame.ground_truth.empty()) {
     ThrowInputError(frame.rgbd.name, "ground truth", "a frame with ground-truth poses (YCB-Video prefix or BOP image)");
   }

@@ -121,7 +121,7 @@ int RunRecognize(const RecognizeArgs& args) {
   Recognizer recognizer(library, args.options);
 
   if (frames.empty()) {  // one frame
-    const LoadedFrame loaded = LoadFrame(args.frame);
+    const LoadedFrame loaded = app::LoadFrameWithWarnings(args.frame);
     const RecognitionResult result = recognizer.Recognize(loaded.rgbd);
     PrintDetections(loaded, result);
     if (!args.out_json.empty()) WriteJsonFile(args.out_json, RecognitionToJson(result));
@@ -147,7 +147,7 @@ int RunRecognize(const RecognizeArgs& args) {
     FrameSpec spec;
     spec.positional = frames[i];
     try {
-      const LoadedFrame loaded = LoadFrame(spec);
+      const LoadedFrame loaded = app::LoadFrameWithWarnings(spec);
       const std::pair<int, int> ids = args.out_bop.empty() ? std::pair{-1, -1} : BopIds(frames[i], -1, -1);
       const RecognitionResult result =
           args.track ? recognizer.Recognize(loaded.rgbd, previous) : recognizer.Recognize(loaded.rgbd);

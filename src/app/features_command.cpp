@@ -42,7 +42,7 @@ nlohmann::json CountsJson(const ExtractionResult& result) {
 }
 
 int RunFeatures(const FeaturesArgs& args) {
-  const LoadedFrame loaded = LoadFrame(args.frame);
+  const LoadedFrame loaded = app::LoadFrameWithWarnings(args.frame);
   const ExtractionResult result = ExtractPrimitives(loaded.rgbd, args.options);
   const ExtractionCounts& c = result.counts;
   std::cout << std::fixed << std::setprecision(1) << "frame " << loaded.rgbd.name << '\n'

@@ -23,6 +23,13 @@ void AddFrameFlags(CLI::App& command, FrameSpec* spec) {
       ->group("Frame from files");
 }
 
+LoadedFrame LoadFrameWithWarnings(const FrameSpec& spec) {
+  std::vector<std::string> warnings;
+  LoadedFrame frame = LoadFrame(spec, &warnings);
+  for (const std::string& warning : warnings) std::cerr << "ecvpose: warning: " << warning << '\n';
+  return frame;
+}
+
 void AddMeshFlags(CLI::App& command, MeshArgs* args) {
   command.add_option("--unit", args->unit, "Unit of mesh coordinates")
       ->check(CLI::IsMember({"m", "cm", "mm"}))

@@ -13,6 +13,10 @@ namespace ecv::app {
 /// `command`; parsed values land in `spec`. The positional FRAME is declared by each command.
 void AddFrameFlags(CLI::App& command, FrameSpec* spec);
 
+/// Loads the frame `spec` names (LoadFrame); what looks suspect (a depth scale off by 10x or more) is printed as
+/// a warning.
+LoadedFrame LoadFrameWithWarnings(const FrameSpec& spec);
+
 /// The mesh flags shared by every subcommand that reads meshes.
 struct MeshArgs {
   std::string unit = "m";               ///< --unit m|cm|mm

@@ -105,14 +105,14 @@ nlohmann::json DescribeMesh(const std::string& path, const InfoArgs& args) {
 
 int RunInfo(const InfoArgs& args) {
   nlohmann::json described = nlohmann::json::array();
-  if (args.paths.empty()) described.push_back(DescribeFrame(LoadFrame(args.frame)));
+  if (args.paths.empty()) described.push_back(DescribeFrame(app::LoadFrameWithWarnings(args.frame)));
   for (const std::string& path : args.paths) {
     if (LooksLikeMesh(path)) {
       described.push_back(DescribeMesh(path, args));
     } else {
       FrameSpec spec = args.frame;
       spec.positional = path;
-      described.push_back(DescribeFrame(LoadFrame(spec)));
+      described.push_back(DescribeFrame(app::LoadFrameWithWarnings(spec)));
     }
   }
   if (!args.out_json.empty()) WriteJsonFile(args.out_json, {{"items", described}});

@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "app/commands.h"
+#include "app/frame_args.h"
 #include "core/pose.h"
 #include "io/frame_io.h"
 #include "io/pose_io.h"
@@ -44,7 +45,7 @@ nlohmann::json ResultJson(const RegistrationResult& result) {
 int RunRegister(RegisterArgs& args) {
   args.options.refine = !args.no_icp;
   args.options.Check();
-  const LoadedFrame a = LoadFrame(args.frame_a), b = LoadFrame(args.frame_b);
+  const LoadedFrame a = app::LoadFrameWithWarnings(args.frame_a), b = app::LoadFrameWithWarnings(args.frame_b);
   const auto start = std::chrono::steady_clock::now();
   const RegistrationView view_a = PrepareRegistrationView(a.rgbd, args.options);
   const RegistrationView view_b = PrepareRegistrationView(b.rgbd, args.options);

@@ -172,16 +172,47 @@ std::vector<std::string> ListSequenceFrames(const std::string& dir_or_list) {
   return frames;
 }
 
-LoadedFrame LoadFrame(const FrameSpec& spec) {
-  if (!spec.positional.empty()) return LoadPositional(spec);
-  if (spec.color_path.empty() || spec.depth_path.empty() || !spec.depth_scale || !spec.camera) {
-    ThrowInputError("frame", "--color/--depth/--depth-scale/--camera",
-                    std::string("all four flags, or one positional FRAME: ") + kFrameForms);
-  }
+LoadedFrame LoadFrame(const FrameSpec& spec, std::vector<std::string>* warnings) {
   LoadedFrame loaded;
-  loaded.rgbd = MakeFrame(spec.color_path, spec.depth_path, *spec.depth_scale,
-                          ParseIntrinsics(*spec.camera, "--camera"), spec.color_path);
+  std::string depth_source = spec.depth_path;
+  if (!spec.positional.empty()) {
+    loaded = LoadPositional(spec);
+    if (depth_source.empty()) depth_source = spec.positional;
+  } else {
+    if (spec.color_path.empty() || spec.depth_path.empty() || !spec.depth_scale || !spec.camera) {
+      ThrowInputError("frame", "--color/--depth/--depth-scale/--camera",
+                      std::string("all four flags, or one positional FRAME: ") + kFrameForms);
+    }
+    loaded.rgbd = MakeFrame(spec.color_path, spec.depth_path, *spec.depth_scale,
+                            ParseIntrinsics(*spec.camera, "--camera"), spec.color_path);
+  }
+  if (warnings != nullptr) {
+    if (std::optional<std::string> warning = DepthRangeWarning(loaded.rgbd.depth, depth_source)) {
+      warnings->push_back(std::move(*warning));
+    }
+  }
   return loaded;
+}
+
+std::optional<std::string> DepthRangeWarning(const cv::Mat& depth_m, const std::string& source) {
+  constexpr double kNearest = 0.1, kFarthest = 10.0;  // metres: what RGB-D cameras measure
+  std::vector<float> measured;
+  for (int v = 0; v < depth_m.rows; ++v) {
+    const float* row = depth_m.ptr<float>(v);
+    for (int u = 0; u < depth_m.cols; ++u) {
+      if (row[u] > 0.0F) measured.push_back(row[u]);
+    }
+  }
+  if (measured.empty()) return std::nullopt;
+  std::nth_element(measured.begin(), measured.begin() + static_cast<std::ptrdiff_t>(measured.size() / 2),
+                   measured.end());
+  const double median = measured[measured.size() / 2];
+  if (median >= kNearest && median <= kFarthest) return std::nullopt;
+  std::ostringstream text;
+  text << source << ": median depth " << median << " m, outside " << kNearest << "-" << kFarthest
+       << " m: is the depth scale right? (--depth-scale S = depth values per metre: YCB-Video 10000, millimetre PNGs "
+          "1000)";
+  return text.str();
 }
 
 cv::Mat ReadColorImage(const std::string& path) {

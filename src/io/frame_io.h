@@ -28,8 +28,15 @@ struct LoadedFrame {
   std::vector<GroundTruth> ground_truth;
 };
 
-/// Loads the frame named by `spec`. Throws InputError naming the file and field on any broken input.
-LoadedFrame LoadFrame(const FrameSpec& spec);
+/// Loads the frame named by `spec`. Throws InputError naming the file and field on any broken input. Adds to
+/// `warnings` what is readable but suspect (DepthRangeWarning).
+LoadedFrame LoadFrame(const FrameSpec& spec, std::vector<std::string>* warnings = nullptr);
+
+/// A warning naming `source` when the median of the measured depths (metres) lies outside 0.1-10 m, the
+/// mark of a wrong depth scale (a millimetre PNG read as YCB-Video's 10 000 per metre, say): every scene
+/// primitive would then be isolated and nothing found, without an error. Empty when the depths look right
+/// or there are none.
+std::optional<std::string> DepthRangeWarning(const cv::Mat& depth_m, const std::string& source);
 
 /// Colour image, PNG or JPG, as CV_8UC3 RGB.
 cv::Mat ReadColorImage(const std::string& path);

@@ -12,6 +12,7 @@ namespace {
 
 using ::testing::AllOf;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 TEST(Cli, VersionHelpAndUsageErrors) {
   const test::CommandResult version = test::RunCli("--version");
@@ -60,6 +61,15 @@ TEST(Cli, InfoReadsEveryFrameForm) {
                    "-depth.png --depth-scale 10000 --camera 1066.778,1067.487,312.9869,241.3109");
   EXPECT_EQ(flags.exit_code, 0) << flags.output;
   EXPECT_THAT(flags.output, HasSubstr("cx 312.987"));
+  EXPECT_THAT(flags.output, Not(HasSubstr("warning")));
+  // YCB-Video's depth PNGs hold 10 000 values per metre; read with a scale of 1 the scene lies kilometres away.
+  // The frame still loads (exit 0), with a warning naming the file.
+  const test::CommandResult wrong_scale =
+      test::RunCli("info --color " + prefix + "-color.png --depth " + prefix +
+                   "-depth.png --depth-scale 1 --camera 1066.778,1067.487,312.9869,241.3109");
+  EXPECT_EQ(wrong_scale.exit_code, 0) << wrong_scale.output;
+  EXPECT_THAT(wrong_scale.output,
+              AllOf(HasSubstr("warning: " + prefix + "-depth.png: median depth"), HasSubstr("depth scale")));
 }
 
 TEST(Cli, BadInputExitsWithOneAndNamesTheFile) {

@@ -42,6 +42,26 @@ TEST(BopFrame, ReadsLmoImageCameraAndEightPoses) {
   EXPECT_NEAR(loaded.ground_truth[1].camera_from_object.translation().z(), 0.96478389285, 1e-9);
 }
 
+TEST(BopFrame, AWrongDepthScaleIsWarnedAboutNamingTheFile) {
+  FrameSpec spec;
+  spec.color_path = test::DataPath("lmo_subset/data/bop/lmo/test/000002/rgb/000003.png");
+  spec.depth_path = test::DataPath("lmo_subset/SAM-6D/Data/Example/depth.png");  // millimetres
+  spec.camera = "572.4114,573.57043,325.2611,242.04899";
+  for (const double scale : {1000.0, 1.0, 0.001, 10000.0, 100000.0}) {
+    spec.depth_scale = scale;
+    std::vector<std::string> warnings;
+    const LoadedFrame loaded = LoadFrame(spec, &warnings);
+    const bool wrong = scale != 1000.0 && scale != 10000.0;  // the scene lies at about 1 m: 0.1 m is still plausible
+    ASSERT_EQ(warnings.size(), wrong ? 1U : 0U) << "scale " << scale;
+    if (wrong) {
+      EXPECT_NE(warnings[0].find(spec.depth_path), std::string::npos) << warnings[0];
+      EXPECT_NE(warnings[0].find("depth scale"), std::string::npos) << warnings[0];
+    }
+    EXPECT_EQ(DepthRangeWarning(loaded.rgbd.depth, "x").has_value(), wrong) << "scale " << scale;
+  }
+  EXPECT_FALSE(DepthRangeWarning(cv::Mat::zeros(4, 4, CV_32FC1), "no depth").has_value());
+}
+
 TEST(BopFrame, ModelCentresProjectIntoTheirBoxes) {
   const LoadedFrame loaded = LoadLmoImage3();
   for (const GroundTruth& truth : loaded.ground_truth) {
