@@ -23,6 +23,9 @@ std::string Fixed(double value, int decimals);
 /// Median of `values` (copied); 0 for none.
 double Median(std::vector<double> values);
 
+/// Mean of `values`; 0 for none.
+double Mean(const std::vector<double>& values);
+
 /// Prints `markdown` and appends it to `results_path` under a heading with `title`, the date, the machine
 /// and the command.
 void Report(const std::string& results_path, const std::string& title, const std::string& command,

@@ -184,10 +184,15 @@ std::string RecallTable(const Runs& runs) {
     out << ' ' << Fixed(static_cast<double>(false_positives[label]) / std::max<size_t>(run.frames.size(), 1), 2)
         << " |";
   }
-  out << "\n| median ms per frame |";
-  for (const auto& [label, run] : runs) {
-    const auto total = run.stage_ms.find("total");
-    out << ' ' << (total == run.stage_ms.end() ? std::string("-") : Fixed(Median(total->second), 0)) << " |";
+  for (const bool median : {true, false}) {
+    out << (median ? "\n| median ms per frame |" : "\n| mean ms per frame |");
+    for (const auto& [label, run] : runs) {
+      const auto total = run.stage_ms.find("total");
+      out << ' '
+          << (total == run.stage_ms.end() ? std::string("-")
+                                          : Fixed(median ? Median(total->second) : Mean(total->second), 0))
+          << " |";
+    }
   }
   out << '\n';
   return out.str();
@@ -195,10 +200,13 @@ std::string RecallTable(const Runs& runs) {
 
 std::string TimingTable(const Run& run) {
   std::ostringstream out;
-  out << "| stage | median ms per frame |\n|---|---:|\n";
+  out << "| stage | median ms per frame | mean ms per frame |\n|---|---:|---:|\n";
   for (const char* stage : {"extract", "describe", "track", "match", "ransac", "verify", "refine", "total"}) {
     const auto found = run.stage_ms.find(stage);
-    if (found != run.stage_ms.end()) out << "| " << stage << " | " << Fixed(Median(found->second), 1) << " |\n";
+    if (found != run.stage_ms.end()) {
+      out << "| " << stage << " | " << Fixed(Median(found->second), 1) << " | " << Fixed(Mean(found->second), 1)
+          << " |\n";
+    }
   }
   return out.str();
 }
