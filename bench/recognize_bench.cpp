@@ -261,8 +261,14 @@ NamedFrame ObjectPixelsOnly(const NamedFrame& frame, const std::vector<PeerModel
   return masked;
 }
 
+const char* kTracking = "ECV + RANSAC + ICP, tracking";
 const char* kPcl = "PCL FPFH + prerejective + ICP";
 const char* kPpf = "OpenCV PPF + ICP";
+
+// The run labelled `name` (it must be there).
+const Run& RunNamed(const Runs& runs, const std::string& name) {
+  return std::find_if(runs.begin(), runs.end(), [&](const auto& run) { return run.first == name; })->second;
+}
 
 // Which methods RunAll runs.
 struct Methods {
@@ -299,7 +305,7 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
              << "identical to one thread's. ";
     }
     if (methods.track) {
-      runs.emplace_back("ECV + RANSAC + ICP, tracking", RunRecognizer(library, options, frames, models, "track", true));
+      runs.emplace_back(kTracking, RunRecognizer(library, options, frames, models, "track", true));
     }
     options.refine = false;
     runs.emplace_back("ECV + RANSAC (no ICP)", RunRecognizer(library, options, frames, models, "no icp"));
@@ -322,11 +328,8 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
     runs.emplace_back(std::string(kPcl) + ", objects' pixels only", RunPeer(*pcl, masked, models, "pcl objects"));
     runs.emplace_back(std::string(kPpf) + ", objects' pixels only", RunPeer(*ppf, masked, models, "ppf objects"));
   }
-  const auto run_named = [&](const std::string& name) -> const Run& {
-    return std::find_if(runs.begin(), runs.end(), [&](const auto& run) { return run.first == name; })->second;
-  };
-  const Run& pcl_run = run_named(kPcl);
-  const Run& ppf_run = run_named(kPpf);
+  const Run& pcl_run = RunNamed(runs, kPcl);
+  const Run& ppf_run = RunNamed(runs, kPpf);
   *notes << "Peers: model set-up (voxel grid, PCL normals + FPFH) " << Fixed(pcl_setup_ms, 0)
          << " ms for PCL, PPF training " << Fixed(ppf_setup_ms, 0) << " ms for OpenCV, not in the times per frame; "
          << "scene cloud " << Fixed(Median(pcl_run.stage_ms.at("scene points")), 0)
@@ -435,7 +438,7 @@ int main(int argc, char** argv) {
     if (methods.ours && methods.track) {
       markdown << "\nThe same with tracking (each frame gets the previous frame's detections of its video as priors; "
                   "the first frame of each video has none):\n\n"
-               << TimingTable(runs[1].second);
+               << TimingTable(RunNamed(runs, kTracking));
     }
     if (!lmo_db.empty()) {
       std::ostringstream lmo_notes;
