@@ -69,6 +69,7 @@ void ModelBuildOptions::Check() const {
   render.Check();
   features.ecv.Check();
   features.descriptor.Check();
+  if (threads < 1) ThrowInputError("model build options", "threads", "at least 1", std::to_string(threads));
 }
 
 double ViewDistance(const BoundingSphere& sphere, const ModelBuildOptions& options) {
@@ -91,7 +92,7 @@ ModelView BuildModelView(Renderer& renderer, MeshId mesh, const Eigen::Isometry3
   MoveIntoObjectFrame(camera_from_object.inverse(), &view.primitives);
   time.extract_ms += MillisecondsSince(start);
   start = Clock::now();
-  view.descriptors = ComputeDescriptors(view.primitives, options.features.descriptor);
+  view.descriptors = ComputeDescriptors(view.primitives, options.features.descriptor, options.threads);
   time.describe_ms += MillisecondsSince(start);
   return view;
 }

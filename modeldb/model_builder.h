@@ -31,6 +31,7 @@ struct ModelBuildOptions {
   PinholeCamera camera = YcbVideoCamera();  ///< intrinsics and image size of every view (stored per view)
   RenderOptions render;                     ///< shading etc. (unlit: the texture's colours as stored)
   FeatureSettings features;                 ///< extraction and descriptor settings
+  int threads = 1;  ///< worker threads describing each view (ComputeDescriptors); the model does not depend on it
 
   /// Throws InputError naming the field for nonsense values (via the parts' Check()).
   void Check() const;

@@ -1,12 +1,14 @@
 // `ecvpose modeldb`: build a model library from meshes into SQLite, and list, inspect, remove, verify, export
 // and migrate it. Compiled only into the ecvpose executable; reads flags into options and calls ecv_modeldb.
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <memory>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "app/commands.h"
@@ -36,6 +38,7 @@ struct ModeldbArgs {
   std::string shading = "unlit";
   bool symmetric = false;
   std::string feature_settings;  // JSON file of FeatureSettings; empty: the defaults
+  int threads = static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
   // list, info, remove, export, verify
   std::string model;
   bool json = false;
@@ -71,6 +74,7 @@ ModelBuildOptions BuildArguments(const ModeldbArgs& args) {
   ModelBuildOptions options;
   options.sampling.num_views = args.views;
   options.distance_m = args.distance_m;
+  options.threads = args.threads;
   options.camera = CameraArgument(args);
   options.render.shading = args.shading == "headlight" ? Shading::kHeadlight : Shading::kUnlit;
   if (!args.feature_settings.empty()) {  // --feature-settings: e.g. {"descriptor": {"pairs": 1}}
@@ -313,6 +317,10 @@ void AddBuildFlags(CLI::App& build, ModeldbArgs* args) {
       ->check(CLI::IsMember({"unlit", "headlight"}))
       ->capture_default_str();
   build.add_flag("--symmetric", args->symmetric, "Mark the models symmetric (evaluated with ADD-S)");
+  build
+      .add_option("--threads", args->threads,
+                  "Worker threads describing each view (the same library for any count; default: all cores)")
+      ->check(CLI::PositiveNumber);
   build.add_option("--feature-settings", args->feature_settings,
                    "JSON of extraction and descriptor settings, {\"ecv\": {...}, \"descriptor\": {...}} as "
                    "`modeldb info` shows them (missing fields: defaults)");

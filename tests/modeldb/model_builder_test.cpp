@@ -126,7 +126,9 @@ TEST_F(BuiltModel, PrimitivesAreInTheObjectFrame) {
 }
 
 TEST_F(BuiltModel, RepeatsBitForBitAndSurvivesStorage) {
-  const BuildResult again = BuildModel(CrackerBox(), FewSmallViews(4), *renderer_);
+  ModelBuildOptions threaded = FewSmallViews(4);
+  threaded.threads = 3;  // the views' descriptors do not depend on the worker threads
+  const BuildResult again = BuildModel(CrackerBox(), threaded, *renderer_);
   EXPECT_EQ(test::CompareViews(built_->record.views, again.record.views), "");
 
   ModelDatabase database(":memory:", OpenMode::kCreate);
@@ -150,6 +152,9 @@ TEST(ModelBuilder, RejectsBadOptionsAndMeshes) {
   } catch (const InputError& error) {
     EXPECT_THAT(error.what(), HasSubstr("num_views"));
   }
+  options = FewSmallViews(1);
+  options.threads = 0;
+  EXPECT_THROW(BuildModel(CrackerBox(), options, renderer), InputError);
   test::TemporaryDirectory directory;
   std::ofstream(directory.File("broken.obj")) << "v 0 0 0\nthis is not an OBJ line\n";
   ModelSource broken;
