@@ -1,14 +1,12 @@
 // `ecvpose modeldb`: build a model library from meshes into SQLite, and list, inspect, remove, verify, export
 // and migrate it. Compiled only into the ecvpose executable; reads flags into options and calls ecv_modeldb.
 
-#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <memory>
 #include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "app/commands.h"
@@ -38,7 +36,7 @@ struct ModeldbArgs {
   std::string shading = "unlit";
   bool symmetric = false;
   std::string feature_settings;  // JSON file of FeatureSettings; empty: the defaults
-  int threads = static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
+  int threads = app::AllCores();
   // list, info, remove, export, verify
   std::string model;
   bool json = false;

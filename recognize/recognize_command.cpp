@@ -1,6 +1,5 @@
 // `ecvpose recognize --db lib.sqlite FRAME`: finds the library's objects in an RGB-D frame.
 
-#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -8,7 +7,6 @@
 #include <iostream>
 #include <memory>
 #include <sstream>
-#include <thread>
 
 #include "app/commands.h"
 #include "app/frame_args.h"
@@ -204,7 +202,7 @@ CommandAction SetupRecognizeCommand(CLI::App& command) {
                      "Picture: each detected model in red with its name (PNG); with --sequence a directory,\n"
                      "one DIR/0001.png ... per frame in sequence order");
   RecognizerOptions& options = args->options;
-  options.ransac.threads = static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
+  options.ransac.threads = app::AllCores();
   command.add_option("--views-per-model", options.views_per_model, "Library views tried with RANSAC per model")
       ->capture_default_str();
   command.add_option("--min-score", options.min_score, "Detections below this score are dropped")
@@ -212,7 +210,7 @@ CommandAction SetupRecognizeCommand(CLI::App& command) {
   command.add_option("--seed", options.ransac.seed, "Random seed")->capture_default_str();
   command
       .add_option("--threads", options.ransac.threads,
-                  "Worker threads for view ranking and RANSAC (same result for any count)")
+                  "Worker threads for describing the scene, view ranking and RANSAC (same result for any count)")
       ->capture_default_str();
   command.add_flag(
       "--no-icp", [&options = args->options](int64_t) { options.refine = false; }, "Skip the ICP refinement");

@@ -1,6 +1,8 @@
 #include "app/frame_args.h"
 
+#include <algorithm>
 #include <iostream>
+#include <thread>
 #include <vector>
 
 #include "io/mesh_io.h"
@@ -28,6 +30,10 @@ LoadedFrame LoadFrameWithWarnings(const FrameSpec& spec) {
   LoadedFrame frame = LoadFrame(spec, &warnings);
   for (const std::string& warning : warnings) std::cerr << "ecvpose: warning: " << warning << '\n';
   return frame;
+}
+
+int AllCores() {
+  return static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
 }
 
 void AddMeshFlags(CLI::App& command, MeshArgs* args) {

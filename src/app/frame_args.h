@@ -17,6 +17,9 @@ void AddFrameFlags(CLI::App& command, FrameSpec* spec);
 /// a warning.
 LoadedFrame LoadFrameWithWarnings(const FrameSpec& spec);
 
+/// Default of the --threads flags: every core of the machine (at least 1).
+int AllCores();
+
 /// The mesh flags shared by every subcommand that reads meshes.
 struct MeshArgs {
   std::string unit = "m";               ///< --unit m|cm|mm
