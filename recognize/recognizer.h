@@ -24,10 +24,12 @@ struct RecognizerOptions {
   /// RANSAC per model view; the paper's test (t_poly 0.25, eps 1 cm, 50 % of the visible object points).
   RansacOptions ransac = DefaultRansac();
   /// Views per model tried with RANSAC, the best ranked first. On the 30 YCB-Video frames, RANSAC seeds 1/2/3:
-  /// 5 views at 10 000 samples (DefaultRansac) found 49/43/44 of 70 objects, 3 views at ~37 000 found 45/39/39;
-  /// with seed 1, 6 views found 46-48 and 8 views at 5000 samples 43. The right view is often not ranked first: the
-  /// view nearest the true pose, put first, found 20 of 35 objects alone (15 of the frames), the best-ranked one 16.
-  int views_per_model = 5;
+  /// 7 views found 49/47/46 of 70 objects and 5 views 47/43/44 (both with ransac_stride_px 4 and approximate
+  /// search from 100 descriptors; before those, 5 views found 49/43/44); 3 views at ~37 000 samples found 45/39/39,
+  /// and with seed 1, 8 views at 5000 samples 43. The right view is often not ranked first: of the 70 objects, 68
+  /// have a library view with 6 or more right correspondences among its 200 ranking ones, and such a view is
+  /// among the best-ranked 5 for 56 of them (session 7, scratch study).
+  int views_per_model = 7;
   /// The scene's descriptors take at most this many neighbours (spread over the distance ranks, see
   /// DescriptorOptions::max_neighbours) when the library's setting allows more; 0 keeps the library's.
   /// Pairs grow with its square, so it bounds the describe time of close-ups: on the 10 close-ups of YCB-Video
@@ -45,8 +47,15 @@ struct RecognizerOptions {
   /// Beyond the paper: a RANSAC sample's later correspondences are drawn near its first one, within this
   /// many model diameters (RansacOptions::sample_radius_m); 0 draws them anywhere in the scene.
   double sample_radius_diameters = 1.0;
-  int dense_stride_px = 2;  ///< scene depth points for the inlier count and ICP: every n-th pixel
-  bool refine = true;       ///< point-to-plane ICP of accepted poses against the scene
+  int dense_stride_px = 2;  ///< scene depth points for ICP and verification: every n-th pixel
+  /// Scene depth points for RANSAC's inlier count (with the primitives): every n-th pixel. An inlier needs a
+  /// scene point within 1 cm; points 4 px apart (about 4 mm at 1 m) still show that, with a quarter of the
+  /// points to search. On the 30 YCB-Video frames (seeds 1/2/3, with every 4th of the stride-2 points): 46/42/46
+  /// of 70 objects against 49/43/44 at stride 2, RANSAC 455-595 instead of 550-600 ms per frame (median; two runs
+  /// at a time on 2 cores); with approximate search from 100 descriptors as well (DefaultMatch), 47/43/44 and
+  /// 330-380 ms.
+  int ransac_stride_px = 4;
+  bool refine = true;  ///< point-to-plane ICP of accepted poses against the scene
   IcpOptions icp;
   /// ICP pairs each model point with the scene depth sample it projects to (RefinePointToPlaneProjective)
   /// instead of the nearest scene point in 3D (RefinePointToPlane over the points near the object). On the
@@ -89,7 +98,8 @@ struct RecognizerOptions {
   bool use_color_matrix = true;
 
   static RansacOptions DefaultRansac();
-  /// 32 checks instead of 128: on 15 YCB-Video frames the same recall, and matching 2.2x faster.
+  /// 32 checks instead of 128: on 15 YCB-Video frames the same recall, and matching 2.2x faster. Approximate
+  /// search from 100 train descriptors on, instead of 1000 (see the .cpp).
   static MatchOptions DefaultMatch();
   /// Throws InputError on values outside their ranges.
   void Check() const;

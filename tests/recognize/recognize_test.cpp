@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/error.h"
 #include "core/pose.h"
 #include "io/frame_io.h"
 #include "io/pose_io.h"
@@ -157,6 +158,27 @@ TEST_F(RecognizeEndToEnd, BadInputIsReported) {
   EXPECT_NE(missing_frame.output.find("/nonexistent/000001"), std::string::npos) << missing_frame.output;
   const test::CommandResult no_db = test::RunCli("recognize " + Frame());
   EXPECT_EQ(no_db.exit_code, 2) << no_db.output;
+}
+
+TEST(RecognizerOptions, OutOfRangeValuesAreReportedByName) {
+  EXPECT_NO_THROW(RecognizerOptions().Check());
+  auto message = [](const RecognizerOptions& options) {
+    try {
+      options.Check();
+    } catch (const InputError& error) {
+      return std::string(error.what());
+    }
+    return std::string("no error");
+  };
+  RecognizerOptions options;
+  options.ransac_stride_px = 0;
+  EXPECT_NE(message(options).find("ransac_stride_px"), std::string::npos) << message(options);
+  options = RecognizerOptions();
+  options.dense_stride_px = 0;
+  EXPECT_NE(message(options).find("dense_stride_px"), std::string::npos) << message(options);
+  options = RecognizerOptions();
+  options.min_score = 1.5;
+  EXPECT_NE(message(options).find("min_score"), std::string::npos) << message(options);
 }
 
 }  // namespace
