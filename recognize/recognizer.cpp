@@ -130,9 +130,11 @@ void RecognizerOptions::Check() const {
   require(consistency_max_correspondences >= 3, "consistency_max_correspondences", "at least 3");
   require(dense_stride_px >= 1, "dense_stride_px", "at least 1");
   require(ransac_stride_px >= 1, "ransac_stride_px", "at least 1");
+  require(icp_max_points >= 0, "icp_max_points", ">= 0 (0: all)");
   require(sample_radius_diameters >= 0.0, "sample_radius_diameters", ">= 0 (0: sample anywhere)");
   require(depth_tolerance_m > 0.0, "depth_tolerance_m", "> 0 m");
   require(scene_max_neighbours >= 0, "scene_max_neighbours", ">= 0 (0: the library's setting)");
+  require(scene_max_descriptors >= 0, "scene_max_descriptors", ">= 0 (0: every primitive)");
   require(max_overlap >= 0.0 && max_overlap <= 1.0, "max_overlap", "in [0, 1]");
   require(color_blur_px >= 0.0, "color_blur_px", ">= 0 pixels");
   require(min_score >= 0.0 && min_score <= 1.0, "min_score", "in [0, 1]");
@@ -268,7 +270,9 @@ class Recognizer::Impl {
         (describe.max_neighbours == 0 || describe.max_neighbours > options_.scene_max_neighbours)) {
       describe.max_neighbours = options_.scene_max_neighbours;
     }
-    scene->descriptors = ComputeDescriptors(scene->primitives, describe, options_.ransac.threads);
+    const size_t count = scene->primitives.size(), most = static_cast<size_t>(options_.scene_max_descriptors);
+    const int source_step = most > 0 && count > most ? static_cast<int>((count + most - 1) / most) : 1;
+    scene->descriptors = ComputeDescriptors(scene->primitives, describe, options_.ransac.threads, source_step);
     if (scene->descriptors.values.rows > 0) {
       scene->matcher = std::make_unique<DescriptorMatcher>(scene->primitives, scene->descriptors, options_.match);
     }
@@ -396,6 +400,11 @@ class Recognizer::Impl {
         const float z = rendered_depth.at<float>(v, u);
         if (z > 0.0F) object_points.push_back(object_from_camera * camera.BackProject({u, v}, z).cast<float>());
       }
+    }
+    if (options_.icp_max_points > 0 && object_points.size() > static_cast<size_t>(options_.icp_max_points)) {
+      const size_t step = (object_points.size() + options_.icp_max_points - 1) / options_.icp_max_points;
+      for (size_t i = 0; i * step < object_points.size(); ++i) object_points[i] = object_points[i * step];
+      object_points.resize((object_points.size() + step - 1) / step);
     }
     if (object_points.size() < 10) return;
     if (options_.projective_icp) {

@@ -174,9 +174,13 @@ void DescriptorOptions::Check() const {
   }
 }
 
-Descriptors ComputeDescriptors(const std::vector<Primitive>& input, const DescriptorOptions& options, int threads) {
+Descriptors ComputeDescriptors(const std::vector<Primitive>& input, const DescriptorOptions& options, int threads,
+                               int source_step) {
   options.Check();
   if (threads < 1) ThrowInputError("descriptor computation", "threads", "at least 1", std::to_string(threads));
+  if (source_step < 1) {
+    ThrowInputError("descriptor computation", "source_step", "at least 1", std::to_string(source_step));
+  }
   const std::vector<Primitive> balanced =
       options.balance_colors && !input.empty() ? BalanceColors(input) : std::vector<Primitive>();
   const std::vector<Primitive>& primitives = options.balance_colors ? balanced : input;
@@ -194,16 +198,23 @@ Descriptors ComputeDescriptors(const std::vector<Primitive>& input, const Descri
   flann::SearchParams search;
   search.sorted = true;  // neighbours by distance to the source: the pair order of the paper
   const float squared_radius = static_cast<float>(options.radius_m * options.radius_m);
-  std::vector<std::vector<size_t>> neighbour_lists;
+  // The sources: every source_step-th primitive (all of them are neighbours).
+  const size_t step = static_cast<size_t>(source_step);
+  const size_t sources = (primitives.size() + step - 1) / step;
+  std::vector<float> source_positions(3 * sources);
+  for (size_t s = 0; s < sources; ++s) std::copy_n(&positions[3 * s * step], 3, &source_positions[3 * s]);
+  std::vector<std::vector<size_t>> neighbour_lists;  // per source
   std::vector<std::vector<float>> distances;
-  index.radiusSearch(points, neighbour_lists, distances, squared_radius, search);
+  index.radiusSearch(flann::Matrix<float>(source_positions.data(), sources, 3), neighbour_lists, distances,
+                     squared_radius, search);
 
   const AppearanceValues appearance = ComputeAppearance(primitives, options.appearance);
   const Context context{primitives, appearance, options};
-  // Row i describes primitive i; the rows of isolated primitives are dropped at the end.
-  cv::Mat values(static_cast<int>(primitives.size()), kDescriptorSize, CV_32F);
-  auto describe = [&](size_t i) {
-    const std::vector<size_t>& found = neighbour_lists[i];  // by distance, the source first
+  // Row s describes source s (primitive s * step); the rows of isolated sources are dropped at the end.
+  cv::Mat values(static_cast<int>(sources), kDescriptorSize, CV_32F);
+  auto describe = [&](size_t s) {
+    const size_t i = s * step;
+    const std::vector<size_t>& found = neighbour_lists[s];  // by distance, the source first
     const size_t cap = options.max_neighbours > 0 ? static_cast<size_t>(options.max_neighbours) : found.size();
     std::vector<int> neighbours;
     std::vector<float> neighbour_distances;
@@ -211,15 +222,15 @@ Descriptors ComputeDescriptors(const std::vector<Primitive>& input, const Descri
       // All, or evenly spread over the distance ranks, so that the context still spans the whole radius.
       const size_t k = found.size() <= cap ? j : j * (found.size() - 1) / (cap - 1);
       neighbours.push_back(static_cast<int>(found[k]));
-      neighbour_distances.push_back(std::sqrt(distances[i][k]));
+      neighbour_distances.push_back(std::sqrt(distances[s][k]));
     }
     DescribeContext(context, static_cast<int>(i), neighbours, neighbour_distances,
-                    values.ptr<float>(static_cast<int>(i)));
+                    values.ptr<float>(static_cast<int>(s)));
   };
   std::atomic<size_t> next{0};
   auto work = [&] {
-    for (size_t i = next++; i < primitives.size(); i = next++) {
-      if (neighbour_lists[i].size() >= 2) describe(i);  // isolated: no context
+    for (size_t s = next++; s < sources; s = next++) {
+      if (neighbour_lists[s].size() >= 2) describe(s);  // isolated: no context
     }
   };
   std::vector<std::thread> workers;
@@ -227,12 +238,15 @@ Descriptors ComputeDescriptors(const std::vector<Primitive>& input, const Descri
   work();
   for (std::thread& worker : workers) worker.join();
 
-  for (size_t i = 0; i < primitives.size(); ++i) {
-    if (neighbour_lists[i].size() >= 2) descriptors.primitive.push_back(static_cast<int>(i));
+  std::vector<int> rows;  // of `values`
+  for (size_t s = 0; s < sources; ++s) {
+    if (neighbour_lists[s].size() < 2) continue;
+    rows.push_back(static_cast<int>(s));
+    descriptors.primitive.push_back(static_cast<int>(s * step));
   }
-  descriptors.values.create(static_cast<int>(descriptors.primitive.size()), kDescriptorSize, CV_32F);
-  for (size_t row = 0; row < descriptors.primitive.size(); ++row) {
-    values.row(descriptors.primitive[row]).copyTo(descriptors.values.row(static_cast<int>(row)));
+  descriptors.values.create(static_cast<int>(rows.size()), kDescriptorSize, CV_32F);
+  for (size_t row = 0; row < rows.size(); ++row) {
+    values.row(rows[row]).copyTo(descriptors.values.row(static_cast<int>(row)));
   }
   return descriptors;
 }

@@ -88,8 +88,10 @@ struct Descriptors {
 /// values (R_Ak = c_b[k] - c_a[k] in the paper; see DescriptorAppearance) to six 16-bin histograms over
 /// [-1, 1] (over [0, 1] for unsigned cosines), each normalised to sum 1. Neighbours of both types form
 /// the context.
-/// `threads` worker threads share the primitives out; the result does not depend on their number.
+/// `threads` worker threads share the primitives out; the result does not depend on their number. With
+/// `source_step` n > 1 only every n-th primitive (0, n, 2n, ...) is a source and gets a descriptor, the same
+/// one it gets with n = 1; every primitive still belongs to the contexts.
 Descriptors ComputeDescriptors(const std::vector<Primitive>& primitives, const DescriptorOptions& options = {},
-                               int threads = 1);
+                               int threads = 1, int source_step = 1);
 
 }  // namespace ecv

@@ -148,6 +148,30 @@ TEST(EcvDescriptor, SameDescriptorsWithAnyNumberOfThreads) {
   EXPECT_THROW(ComputeDescriptors(primitives, {}, 0), InputError);
 }
 
+TEST(EcvDescriptor, ASourceStepDescribesEveryNthPrimitiveAsTheFullRunDoes) {
+  std::vector<Primitive> primitives = RandomPrimitives(500, 7);
+  primitives[3].position = {1.0F, 1.0F, 1.0F};  // isolated, and a source with step 3
+  for (const auto& [name, options] : Variants()) {
+    const Descriptors all = ComputeDescriptors(primitives, options);
+    for (const int step : {2, 3, 7}) {
+      const Descriptors some = ComputeDescriptors(primitives, options, 2, step);
+      std::vector<int> expected;
+      for (size_t row = 0; row < all.primitive.size(); ++row) {
+        if (all.primitive[row] % step != 0) continue;
+        expected.push_back(all.primitive[row]);
+        const int found = static_cast<int>(std::find(some.primitive.begin(), some.primitive.end(), all.primitive[row]) -
+                                           some.primitive.begin());
+        ASSERT_LT(found, some.values.rows) << name << ", step " << step;
+        EXPECT_EQ(cv::norm(some.values.row(found), all.values.row(static_cast<int>(row)), cv::NORM_INF), 0.0)
+            << name << ", step " << step << ", primitive " << all.primitive[row];
+      }
+      EXPECT_EQ(some.primitive, expected) << name << ", step " << step;
+      EXPECT_EQ(some.values.rows, static_cast<int>((500 + step - 1) / step) - (step == 3 ? 1 : 0)) << name;
+    }
+  }
+  EXPECT_THROW(ComputeDescriptors(primitives, {}, 1, 0), InputError);
+}
+
 TEST(EcvDescriptor, IsolatedPrimitivesGetNone) {
   std::vector<Primitive> primitives = RandomPrimitives(3, 2);
   primitives[0].position = {0, 0, 1};

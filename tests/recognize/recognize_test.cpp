@@ -177,6 +177,12 @@ TEST(RecognizerOptions, OutOfRangeValuesAreReportedByName) {
   options.dense_stride_px = 0;
   EXPECT_NE(message(options).find("dense_stride_px"), std::string::npos) << message(options);
   options = RecognizerOptions();
+  options.scene_max_descriptors = -1;
+  EXPECT_NE(message(options).find("scene_max_descriptors"), std::string::npos) << message(options);
+  options = RecognizerOptions();
+  options.icp_max_points = -1;
+  EXPECT_NE(message(options).find("icp_max_points"), std::string::npos) << message(options);
+  options = RecognizerOptions();
   options.min_score = 1.5;
   EXPECT_NE(message(options).find("min_score"), std::string::npos) << message(options);
 }
