@@ -65,18 +65,6 @@ Descriptors SampleRows(const Descriptors& descriptors, size_t count, uint64_t se
   return subset;
 }
 
-// The frame's depth samples of every `stride`-th pixel in each direction, as camera-frame points.
-std::vector<Eigen::Vector3f> DepthPoints(const RgbdFrame& frame, int stride) {
-  std::vector<Eigen::Vector3f> points;
-  for (int v = 0; v < frame.depth.rows; v += stride) {
-    for (int u = 0; u < frame.depth.cols; u += stride) {
-      const float z = frame.depth.at<float>(v, u);
-      if (z > 0.0F) points.push_back(frame.camera.BackProject({u, v}, z).cast<float>());
-    }
-  }
-  return points;
-}
-
 // A verified pose: the detection, the pixels (at dense_stride_px) where its rendered surface lies on the
 // scene's, which overlap suppression compares, and the rendered depth (for the frame's camera sampled at
 // dense_stride_px), from which ICP takes the model's surface.

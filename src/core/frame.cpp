@@ -59,4 +59,15 @@ DepthStats ComputeDepthStats(const cv::Mat& depth, const cv::Mat& mask) {
   return stats;
 }
 
+std::vector<Eigen::Vector3f> DepthPoints(const RgbdFrame& frame, int stride) {
+  std::vector<Eigen::Vector3f> points;
+  for (int v = 0; v < frame.depth.rows; v += stride) {
+    for (int u = 0; u < frame.depth.cols; u += stride) {
+      const float z = frame.depth.at<float>(v, u);
+      if (z > 0.0F) points.push_back(frame.camera.BackProject({u, v}, z).cast<float>());
+    }
+  }
+  return points;
+}
+
 }  // namespace ecv

@@ -1,7 +1,9 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
+#include <Eigen/Core>
 #include <opencv2/core.hpp>
 
 #include "core/camera.h"
@@ -30,5 +32,8 @@ struct DepthStats {
 
 /// Statistics over the valid (> 0) pixels of a CV_32FC1 depth image, optionally only where `mask` != 0.
 DepthStats ComputeDepthStats(const cv::Mat& depth, const cv::Mat& mask = cv::Mat());
+
+/// The frame's depth samples of every `stride`-th pixel in each direction (row by row), as camera-frame points.
+std::vector<Eigen::Vector3f> DepthPoints(const RgbdFrame& frame, int stride);
 
 }  // namespace ecv

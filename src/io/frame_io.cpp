@@ -196,17 +196,9 @@ LoadedFrame LoadFrame(const FrameSpec& spec, std::vector<std::string>* warnings)
 
 std::optional<std::string> DepthRangeWarning(const cv::Mat& depth_m, const std::string& source) {
   constexpr double kNearest = 0.1, kFarthest = 10.0;  // metres: what RGB-D cameras measure
-  std::vector<float> measured;
-  for (int v = 0; v < depth_m.rows; ++v) {
-    const float* row = depth_m.ptr<float>(v);
-    for (int u = 0; u < depth_m.cols; ++u) {
-      if (row[u] > 0.0F) measured.push_back(row[u]);
-    }
-  }
-  if (measured.empty()) return std::nullopt;
-  std::nth_element(measured.begin(), measured.begin() + static_cast<std::ptrdiff_t>(measured.size() / 2),
-                   measured.end());
-  const double median = measured[measured.size() / 2];
+  const DepthStats stats = ComputeDepthStats(depth_m);
+  if (stats.valid_fraction == 0.0) return std::nullopt;
+  const double median = stats.median_m;
   if (median >= kNearest && median <= kFarthest) return std::nullopt;
   std::ostringstream text;
   text << source << ": median depth " << median << " m, outside " << kNearest << "-" << kFarthest

@@ -28,12 +28,7 @@ RegistrationView PrepareRegistrationView(const RgbdFrame& frame, const Registrat
   frame.Check();
   RegistrationView view;
   view.primitives = ExtractPrimitives(frame, options.features).primitives;
-  for (int v = 0; v < frame.depth.rows; v += options.dense_stride_px) {
-    for (int u = 0; u < frame.depth.cols; u += options.dense_stride_px) {
-      const float z = frame.depth.at<float>(v, u);
-      if (z > 0.0F) view.dense_points.push_back(frame.camera.BackProject({u, v}, z).cast<float>());
-    }
-  }
+  view.dense_points = DepthPoints(frame, options.dense_stride_px);
   return view;
 }
 
