@@ -68,37 +68,65 @@ FrameEvaluation EvaluateFrame(const std::string& frame, const std::vector<Detect
   };
   std::map<std::string, const EvalModel*> by_name;
   for (const EvalModel& model : models) by_name[model.name] = &model;
-  // The judged detection of each model present: its highest-scoring one; the others are false positives.
-  std::map<std::string, const Detection*> judged;
-  for (const Detection& detection : detections) {
-    const auto present = std::find_if(truth.begin(), truth.end(),
-                                      [&](const GroundTruth& t) { return t.object_name == detection.model; });
-    if (present == truth.end()) {
-      add_false_positive(detection.model);
-      continue;
-    }
-    const auto [best, inserted] = judged.emplace(detection.model, &detection);
-    if (inserted) continue;
-    add_false_positive(detection.model);
-    if (detection.score > best->second->score) best->second = &detection;
-  }
+  // Per ground-truth object of a library model: its result, and the error of every detection of its model.
+  struct Instance {
+    const GroundTruth* truth;
+    const EvalModel* model;
+    ObjectEvaluation result;
+  };
+  std::vector<Instance> instances;
   for (const GroundTruth& object : truth) {
     const auto model = by_name.find(object.object_name);
     if (model == by_name.end()) continue;  // not in the library: not asked for
-    ObjectEvaluation result;
-    result.model = object.object_name;
-    result.diameter_m = model->second->diameter_m;
-    const auto found = judged.find(object.object_name);
-    if (found != judged.end()) {
-      result.detected = true;
-      result.error =
-          ComputePoseError(model->second->points, found->second->camera_from_object, object.camera_from_object);
-      const double distance = model->second->symmetric ? result.error.adds_m : result.error.add_m;
-      result.correct = distance < 0.1 * result.diameter_m;
-      if (!result.correct) add_false_positive(object.object_name);
-    }
-    evaluation.objects.push_back(result);
+    Instance instance{&object, model->second, {}};
+    instance.result.model = object.object_name;
+    instance.result.diameter_m = model->second->diameter_m;
+    instances.push_back(instance);
   }
+  auto correct = [](const Instance& instance, const PoseError& error) {
+    const double distance = instance.model->symmetric ? error.adds_m : error.add_m;
+    return distance < 0.1 * instance.model->diameter_m;
+  };
+  // Best score first, each detection takes the nearest (by ADD) instance of its model that it finds correctly
+  // and that no better detection took; one that takes none is a false positive.
+  std::vector<const Detection*> ranked;
+  for (const Detection& detection : detections) ranked.push_back(&detection);
+  std::stable_sort(ranked.begin(), ranked.end(),
+                   [](const Detection* a, const Detection* b) { return a->score > b->score; });
+  std::vector<const Detection*> unmatched;
+  for (const Detection* detection : ranked) {
+    Instance* taken = nullptr;
+    PoseError taken_error;
+    for (Instance& instance : instances) {
+      if (instance.truth->object_name != detection->model || instance.result.correct) continue;
+      const PoseError error =
+          ComputePoseError(instance.model->points, detection->camera_from_object, instance.truth->camera_from_object);
+      if (correct(instance, error) && (taken == nullptr || error.add_m < taken_error.add_m)) {
+        taken = &instance;
+        taken_error = error;
+      }
+    }
+    if (taken == nullptr) {
+      add_false_positive(detection->model);
+      unmatched.push_back(detection);
+      continue;
+    }
+    taken->result.detected = taken->result.correct = true;
+    taken->result.error = taken_error;
+  }
+  // An instance no detection found is still shown with the error of its model's best unmatched detection
+  // (already a false positive), if any.
+  for (Instance& instance : instances) {
+    if (instance.result.correct) continue;
+    for (const Detection* detection : unmatched) {
+      if (detection->model != instance.truth->object_name) continue;
+      instance.result.detected = true;
+      instance.result.error =
+          ComputePoseError(instance.model->points, detection->camera_from_object, instance.truth->camera_from_object);
+      break;
+    }
+  }
+  for (const Instance& instance : instances) evaluation.objects.push_back(instance.result);
   return evaluation;
 }
 

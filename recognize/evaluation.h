@@ -39,9 +39,9 @@ EvalModel EvalModelFromRecord(const ModelRecord& record, size_t max_points = 400
 /// The outcome for one ground-truth object of a frame.
 struct ObjectEvaluation {
   std::string model;
-  bool detected = false;  ///< a detection of this model exists
-  bool correct = false;   ///< its ADD (ADD-S when symmetric) is below 0.1 x diameter
-  PoseError error;        ///< when detected
+  bool detected = false;  ///< a detection of this model exists (see EvaluateFrame)
+  bool correct = false;   ///< a detection found it: ADD (ADD-S when symmetric) below 0.1 x diameter
+  PoseError error;        ///< of that detection, when detected
   double diameter_m = 0.0;
 };
 
@@ -55,8 +55,10 @@ struct FrameEvaluation {
   std::string missed;
 };
 
-/// Matches detections to the ground truth by model name (one instance per model): the highest-scoring
-/// detection of a model present is judged; further detections of it count as false positives.
+/// Matches detections to the ground truth by model name, any number of instances per model (as BOP does): in
+/// order of score, each detection takes the nearest not yet taken instance of its model that it finds within
+/// ADD (ADD-S when symmetric) < 0.1 x diameter; a detection that takes none is a false positive. An instance
+/// left untaken shows the error of its model's best-scoring false positive, when there is one.
 FrameEvaluation EvaluateFrame(const std::string& frame, const std::vector<Detection>& detections,
                               const std::vector<GroundTruth>& truth, const std::vector<EvalModel>& models);
 

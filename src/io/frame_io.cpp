@@ -319,4 +319,32 @@ LoadedFrame LoadFrameJson(const std::string& path) {
   return loaded;
 }
 
+void WriteFrameJson(const std::string& path, const RgbdFrame& frame, double depth_scale) {
+  frame.Check();
+  if (!(depth_scale > 0.0)) ThrowInputError(path, "depth_scale", "> 0");
+  double deepest = 0.0;
+  cv::minMaxLoc(frame.depth, nullptr, &deepest);
+  if (deepest * depth_scale > 65535.0) {
+    ThrowInputError(path, "depth_scale", "small enough for a 16-bit PNG: depth up to 65535 / S metres");
+  }
+  const fs::path json_path(path);
+  const std::string stem = json_path.stem().string();
+  const std::string color_name = stem + "-color.png", depth_name = stem + "-depth.png";
+  const fs::path base = json_path.parent_path();
+  WriteColorImage((base / color_name).string(), frame.color);
+  cv::Mat depth_units;
+  frame.depth.convertTo(depth_units, CV_16UC1, depth_scale);
+  bool written = false;
+  try {
+    written = cv::imwrite((base / depth_name).string(), depth_units);
+  } catch (const cv::Exception&) {
+  }
+  if (!written) ThrowInputError((base / depth_name).string(), "depth", "a writable PNG path");
+  const PinholeCamera& camera = frame.camera;
+  WriteJsonFile(path, {{"color", color_name},
+                       {"depth", depth_name},
+                       {"depth_scale", depth_scale},
+                       {"camera", {camera.fx, camera.fy, camera.cx, camera.cy}}});
+}
+
 }  // namespace ecv

@@ -61,6 +61,16 @@ LoadedFrame LoadFrameJson(const std::string& path);
 /// factor_depth and the ground-truth poses).
 LoadedFrame LoadYcbvFrame(const std::string& prefix);
 
+/// `frame` with an object of another YCB-Video frame pasted in: the pixels that frame's label image
+/// (`source_prefix`-label.png) gives the object, colour and depth, and its ground truth. Both frames must come
+/// from one camera (InputError otherwise), so the object lies at its ground-truth pose: real pixels for testing
+/// several instances of one model. InputError when the source frame lacks the object or its label pixels.
+LoadedFrame PasteYcbvObject(LoadedFrame frame, const std::string& source_prefix, const std::string& object_name);
+
+/// Writes `frame` as a frame JSON (`path`, the CLI's FRAME form) with `<stem>-color.png` and a 16-bit
+/// `<stem>-depth.png` (depth value = metres x `depth_scale`) beside it; throws InputError if it cannot.
+void WriteFrameJson(const std::string& path, const RgbdFrame& frame, double depth_scale = 10000.0);
+
 /// BOP image `image_id` of `scene_dir` (scene_camera.json, scene_gt.json, scene_gt_info.json,
 /// rgb/, depth/); `depth_override` replaces the depth image when not empty.
 LoadedFrame LoadBopFrame(const std::string& scene_dir, int image_id, const std::string& depth_override = "");

@@ -1,11 +1,13 @@
 // YCB-Video frames: <prefix>-color.png, <prefix>-depth.png and <prefix>-meta.mat (MATLAB v5, read with
 // matio): intrinsic_matrix (3x3), factor_depth, cls_indexes (N), poses (3x4xN, model to camera, metres).
 
+#include <algorithm>
 #include <array>
 #include <memory>
 #include <vector>
 
 #include <matio.h>
+#include <opencv2/imgcodecs.hpp>
 
 #include "core/error.h"
 #include "io/frame_io.h"
@@ -117,6 +119,34 @@ LoadedFrame LoadYcbvFrame(const std::string& prefix) {
     loaded.ground_truth.push_back(truth);
   }
   return loaded;
+}
+
+LoadedFrame PasteYcbvObject(LoadedFrame frame, const std::string& source_prefix, const std::string& object_name) {
+  const LoadedFrame source = LoadYcbvFrame(source_prefix);
+  const PinholeCamera& into = frame.rgbd.camera;
+  const PinholeCamera& from = source.rgbd.camera;
+  if (from.fx != into.fx || from.fy != into.fy || from.cx != into.cx || from.cy != into.cy ||
+      from.width != into.width || from.height != into.height) {
+    ThrowInputError(source_prefix + "-meta.mat", "intrinsic_matrix", "the camera of the frame pasted into");
+  }
+  const auto truth = std::find_if(source.ground_truth.begin(), source.ground_truth.end(),
+                                  [&](const GroundTruth& g) { return g.object_name == object_name; });
+  if (truth == source.ground_truth.end()) ThrowInputError(source_prefix + "-meta.mat", "cls_indexes", object_name);
+  const std::string label_path = source_prefix + "-label.png";
+  const cv::Mat labels = cv::imread(label_path, cv::IMREAD_UNCHANGED);
+  if (labels.empty() || labels.size() != source.rgbd.depth.size() || labels.depth() != CV_8U ||
+      labels.channels() != 1) {
+    ThrowInputError(label_path, "label", "an 8-bit one-channel PNG of the frame's size");
+  }
+  const cv::Mat object = labels == truth->object_id;
+  if (cv::countNonZero(object) == 0) {
+    ThrowInputError(label_path, "label",
+                    "pixels of class " + std::to_string(truth->object_id) + " (" + object_name + ")");
+  }
+  source.rgbd.color.copyTo(frame.rgbd.color, object);
+  source.rgbd.depth.copyTo(frame.rgbd.depth, object);
+  frame.ground_truth.push_back(*truth);
+  return frame;
 }
 
 }  // namespace ecv

@@ -1,5 +1,5 @@
 // Real YCB-Video frames: intrinsics, depth scale and ground truth read from -meta.mat agree with the
-// label image and the depth image.
+// label image and the depth image; an object pasted from another frame; a frame JSON written and read back.
 
 #include <algorithm>
 #include <map>
@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include "core/error.h"
 #include "core/frame.h"
 #include "io/frame_io.h"
 #include "io/points_io.h"
@@ -96,6 +97,58 @@ TEST(YcbvFrame, MedianDepthOverLabelsLiesWithinPosedModelDepth) {
     }
   }
   EXPECT_GE(checked, 100);  // 10 frames x (3 + 4 + 6) objects, less the hardly visible ones
+}
+
+// The mustard bottle of 0002/000001 pasted into 0001/000001 (which has one too): exactly its label pixels change,
+// to the source's colour and depth, and its ground truth is added.
+TEST(YcbvFrame, PastedObjectBringsItsPixelsAndGroundTruth) {
+  const LoadedFrame into = LoadYcbvFrame(FramePrefix("0001", 1));
+  const LoadedFrame source = LoadYcbvFrame(FramePrefix("0002", 1));
+  const LoadedFrame pasted = PasteYcbvObject(into, FramePrefix("0002", 1), "006_mustard_bottle");
+  ASSERT_EQ(pasted.ground_truth.size(), into.ground_truth.size() + 1);
+  EXPECT_EQ(pasted.ground_truth.back().object_name, "006_mustard_bottle");
+  EXPECT_TRUE(pasted.ground_truth.back().camera_from_object.isApprox(
+      std::find_if(source.ground_truth.begin(), source.ground_truth.end(), [](const GroundTruth& g) {
+        return g.object_name == "006_mustard_bottle";
+      })->camera_from_object));
+  const cv::Mat label = cv::imread(FramePrefix("0002", 1) + "-label.png", cv::IMREAD_UNCHANGED);
+  const cv::Mat bottle = label == 5;  // class index of 006_mustard_bottle
+  int changed = 0, outside = 0;
+  for (int v = 0; v < label.rows; ++v) {
+    for (int u = 0; u < label.cols; ++u) {
+      const bool in = bottle.at<uchar>(v, u) != 0;
+      const RgbdFrame& expected = in ? source.rgbd : into.rgbd;
+      EXPECT_EQ(pasted.rgbd.depth.at<float>(v, u), expected.depth.at<float>(v, u)) << u << "," << v;
+      EXPECT_EQ(pasted.rgbd.color.at<cv::Vec3b>(v, u), expected.color.at<cv::Vec3b>(v, u)) << u << "," << v;
+      changed += in ? 1 : 0;
+      outside += in ? 0 : 1;
+    }
+  }
+  EXPECT_GT(changed, 5000);
+  EXPECT_GT(outside, 250000);
+  // The banana is not in video 0001's frame: nothing to paste; a BOP frame's camera is another camera.
+  EXPECT_THROW(PasteYcbvObject(into, FramePrefix("0001", 1), "011_banana"), InputError);
+  LoadedFrame other_camera = into;
+  other_camera.rgbd.camera.fx += 1.0;
+  try {
+    PasteYcbvObject(other_camera, FramePrefix("0002", 1), "006_mustard_bottle");
+    FAIL() << "pasted across cameras";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("intrinsic_matrix"), std::string::npos) << error.what();
+  }
+}
+
+TEST(YcbvFrame, FrameJsonRoundTripKeepsColourExactlyAndDepthToATenthOfAMillimetre) {
+  const LoadedFrame frame = LoadYcbvFrame(FramePrefix("0000", 1));
+  const test::TemporaryDirectory directory;
+  const std::string path = directory.File("frame.json");
+  WriteFrameJson(path, frame.rgbd);
+  const LoadedFrame read = LoadFrameJson(path);
+  EXPECT_EQ(cv::norm(read.rgbd.color, frame.rgbd.color, cv::NORM_INF), 0.0);
+  EXPECT_LE(cv::norm(read.rgbd.depth, frame.rgbd.depth, cv::NORM_INF), 0.5e-4 + 1e-7);
+  EXPECT_EQ(read.rgbd.camera.fx, frame.rgbd.camera.fx);
+  EXPECT_EQ(read.rgbd.camera.cy, frame.rgbd.camera.cy);
+  EXPECT_THROW(WriteFrameJson(path, frame.rgbd, 1e6), InputError);  // metres x 1e6 overflow 16 bits
 }
 
 }  // namespace
