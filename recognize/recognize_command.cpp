@@ -207,6 +207,10 @@ CommandAction SetupRecognizeCommand(CLI::App& command) {
       ->capture_default_str();
   command.add_option("--min-score", options.min_score, "Detections below this score are dropped")
       ->capture_default_str();
+  command
+      .add_option("--max-instances", options.max_instances,
+                  "Instances of one model looked for per frame (e.g. a bin of identical parts)")
+      ->capture_default_str();
   command.add_option("--seed", options.ransac.seed, "Random seed")->capture_default_str();
   command
       .add_option("--threads", options.ransac.threads,

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numeric>
+#include <optional>
 #include <random>
 #include <thread>
 
@@ -37,13 +38,6 @@ struct Scene {
   cv::Mat color;                               // the frame's colours, as verification compares them
   OrganizedScene organized;                    // the depth samples with normals, for projective ICP
   SceneVisibility visibility;
-};
-
-// A model view ranked by its consistent correspondences, with the correspondences for RANSAC.
-struct ViewCandidate {
-  int view = -1;
-  int score = 0;
-  std::vector<Correspondence> correspondences;
 };
 
 // At most `count` rows of `descriptors`, drawn at random (seeded) when there are more.
@@ -80,6 +74,34 @@ struct Hypothesis {
   RansacResult ransac;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
 };
+
+// A model view ranked by its consistent correspondences; once tried, its RANSAC pose, verified.
+struct ViewCandidate {
+  int view = -1;
+  int score = 0;
+  bool matched = false;                         // `correspondences` are there
+  std::vector<Correspondence> correspondences;  // the nearest scene primitive of each of its descriptors
+  bool tried = false;                           // RANSAC ran on it (and `verified` is its pose, if any)
+  std::optional<Hypothesis> hypothesis;
+  std::optional<Verified> verified;
+};
+
+// Marks on `covered` (CV_8UC1, the frame's size) the pixels of a verified surface, sampled every `stride`
+// pixels, with the gaps between the samples closed.
+void CoverSurface(const std::vector<cv::Point>& surface, int stride, cv::Mat* covered) {
+  cv::Mat samples = cv::Mat::zeros(covered->size(), CV_8UC1);
+  for (const cv::Point& p : surface) samples.at<uchar>(p) = 1;
+  cv::dilate(samples, samples, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * stride + 1, 2 * stride + 1)));
+  *covered |= samples;
+}
+
+// The share of a verified surface's pixels that are non-zero on `covered` (0 when it is empty).
+double CoveredShare(const std::vector<cv::Point>& surface, const cv::Mat& covered) {
+  if (covered.empty() || surface.empty()) return 0.0;
+  const auto on =
+      std::count_if(surface.begin(), surface.end(), [&](const cv::Point& p) { return covered.at<uchar>(p) != 0; });
+  return static_cast<double>(on) / static_cast<double>(surface.size());
+}
 
 }  // namespace
 
@@ -124,6 +146,8 @@ void RecognizerOptions::Check() const {
   require(scene_max_neighbours >= 0, "scene_max_neighbours", ">= 0 (0: the library's setting)");
   require(scene_max_descriptors >= 0, "scene_max_descriptors", ">= 0 (0: every primitive)");
   require(max_overlap >= 0.0 && max_overlap <= 1.0, "max_overlap", "in [0, 1]");
+  require(max_instances >= 1, "max_instances", "at least 1");
+  require(later_instance_views >= 0, "later_instance_views", ">= 0 (0: views_per_model)");
   require(color_blur_px >= 0.0, "color_blur_px", ">= 0 pixels");
   require(min_score >= 0.0 && min_score <= 1.0, "min_score", "in [0, 1]");
   require(min_track_start_score >= 0.0 && min_track_start_score <= 1.0, "min_track_start_score", "in [0, 1]");
@@ -163,27 +187,42 @@ class Recognizer::Impl {
     const Clock::time_point start = Clock::now();
     RecognitionResult result;
     Scene scene = PrepareScene(frame);
-    std::vector<Verified> candidates;  // each model's best detection
-    std::vector<bool> done(library_.models().size(), false);
+    std::vector<Verified> candidates;
+    // Per model: the instances found so far (tracked, then recognised) and the scene pixels their surfaces cover.
+    std::vector<int> instances(library_.models().size(), 0);
+    std::vector<cv::Mat> covered(library_.models().size());
+    auto add_instance = [&](size_t m, Verified verified) {
+      if (covered[m].empty()) covered[m] = cv::Mat::zeros(frame.depth.size(), CV_8UC1);
+      CoverSurface(verified.surface, options_.dense_stride_px, &covered[m]);
+      ++instances[m];
+      candidates.push_back(std::move(verified));
+    };
     Clock::time_point stage = Clock::now();
     for (const Detection& prior : priors) {
       const std::optional<size_t> m = ModelIndex(prior.model);
-      if (!m || done[*m] || (!prior.tracked && prior.score < options_.min_track_start_score)) continue;
-      Verified tracked = Track(*m, prior, scene);
-      if (Accepted(tracked.detection)) {
-        candidates.push_back(std::move(tracked));
-        done[*m] = true;
+      if (!m || instances[*m] >= options_.max_instances ||
+          (!prior.tracked && prior.score < options_.min_track_start_score)) {
+        continue;
       }
+      Verified tracked = Track(*m, prior, scene);
+      if (Accepted(tracked.detection)) add_instance(*m, std::move(tracked));
     }
     if (!priors.empty()) result.timings_ms["track"] = MillisecondsSince(stage);
+    std::vector<bool> done(library_.models().size());
+    for (size_t m = 0; m < done.size(); ++m) done[m] = instances[m] >= options_.max_instances;
     if (std::count(done.begin(), done.end(), false) > 0) DescribeScene(&scene, &result);  // none when all tracked
     stage = Clock::now();
-    const std::vector<std::vector<ViewCandidate>> ranked = RankAllViews(scene, done);
+    std::vector<std::vector<ViewCandidate>> ranked = RankAllViews(scene, done);
     result.timings_ms["match"] += MillisecondsSince(stage);
     for (size_t m = 0; m < library_.models().size(); ++m) {
-      if (done[m]) continue;
-      std::optional<Verified> best = BestDetection(m, ranked[m], scene, &result.timings_ms);
-      if (best && Accepted(best->detection)) candidates.push_back(std::move(*best));
+      while (instances[m] < options_.max_instances) {
+        // Once an instance is found the model is known to be in the frame: more of its views are worth trying.
+        const int views = instances[m] == 0 || options_.later_instance_views == 0 ? options_.views_per_model
+                                                                                  : options_.later_instance_views;
+        std::optional<Verified> best = BestDetection(m, views, scene, covered[m], &ranked[m], &result.timings_ms);
+        if (!best || !Accepted(best->detection)) break;
+        add_instance(m, std::move(*best));
+      }
     }
     stage = Clock::now();
     result.detections = SuppressOverlaps(frame.depth.size(), std::move(candidates));
@@ -267,31 +306,29 @@ class Recognizer::Impl {
     result->timings_ms["describe"] = MillisecondsSince(stage);
   }
 
-  // The model's best pose over its ranked views: RANSAC per view, each pose verified as it is, the best one
-  // refined by ICP and verified again (kept only if ICP does not lower its score). Adds stage times.
-  std::optional<Verified> BestDetection(size_t model, const std::vector<ViewCandidate>& views, const Scene& scene,
-                                        std::map<std::string, double>* timings_ms) {
-    Clock::time_point stage = Clock::now();
-    std::vector<Hypothesis> hypotheses = EstimatePoses(records_[model], views, scene);
-    (*timings_ms)["ransac"] += MillisecondsSince(stage);
-
-    stage = Clock::now();
-    std::optional<Verified> best;
-    const Hypothesis* best_hypothesis = nullptr;  // of `best`
-    for (const Hypothesis& hypothesis : hypotheses) {
-      Verified verified = Verify(model, scene, hypothesis);
-      if (!best || verified.detection.score > best->detection.score) {
-        best = std::move(verified);
-        best_hypothesis = &hypothesis;
+  // The model's best pose over its best `count` ranked views: RANSAC per view, each pose verified as it is
+  // (both once per view and frame, kept in `ranked`), the best one not lying mostly (max_overlap) on `covered`
+  // pixels (earlier instances) refined by ICP and verified again (kept only if ICP does not lower its score).
+  // Adds stage times.
+  std::optional<Verified> BestDetection(size_t model, int count, const Scene& scene, const cv::Mat& covered,
+                                        std::vector<ViewCandidate>* ranked, std::map<std::string, double>* timings_ms) {
+    const ViewCandidate* best_view = nullptr;
+    for (size_t i = 0; i < std::min(ranked->size(), static_cast<size_t>(count)); ++i) {
+      ViewCandidate& candidate = (*ranked)[i];
+      Try(model, scene, &candidate, timings_ms);
+      if (!candidate.verified || CoveredShare(candidate.verified->surface, covered) > options_.max_overlap) continue;
+      if (best_view == nullptr || candidate.verified->detection.score > best_view->verified->detection.score) {
+        best_view = &candidate;
       }
     }
-    (*timings_ms)["verify"] += MillisecondsSince(stage);
-    if (best_hypothesis == nullptr || !options_.refine) return best;
+    if (best_view == nullptr) return std::nullopt;
+    std::optional<Verified> best = best_view->verified;
+    if (!options_.refine) return best;
 
     // Only the best verified pose is refined: refining the best three as well found 44 instead of 45 of the
     // 70 YCB-Video objects, for 3x the ICP time.
-    stage = Clock::now();
-    Hypothesis refined = *best_hypothesis;
+    Clock::time_point stage = Clock::now();
+    Hypothesis refined = *best_view->hypothesis;
     Refine(model, scene, best->depth, &refined);
     (*timings_ms)["refine"] += MillisecondsSince(stage);
     stage = Clock::now();
@@ -319,8 +356,7 @@ class Recognizer::Impl {
     return ranked;
   }
 
-  // The model's best-ranked views, each with its correspondences: the nearest scene descriptor of each of
-  // its descriptors (paper: object to scene).
+  // The model's views, best ranked first; the best views_per_model with all their correspondences (Match).
   std::vector<ViewCandidate> RankViews(size_t model, const Scene& scene) const {
     std::vector<ViewCandidate> views;
     if (!scene.matcher) return views;
@@ -341,12 +377,19 @@ class Recognizer::Impl {
     }
     std::stable_sort(views.begin(), views.end(),
                      [](const ViewCandidate& a, const ViewCandidate& b) { return a.score > b.score; });
-    views.resize(std::min(views.size(), static_cast<size_t>(options_.views_per_model)));
-    for (ViewCandidate& candidate : views) {
-      const ModelView& view = record.views[static_cast<size_t>(candidate.view)];
-      candidate.correspondences = Correspondences(view, view.descriptors, scene);
+    for (size_t i = 0; i < std::min(views.size(), static_cast<size_t>(options_.views_per_model)); ++i) {
+      Match(model, scene, &views[i]);
     }
     return views;
+  }
+
+  // Gives `candidate` its correspondences, once: the nearest scene descriptor of each of its descriptors (paper:
+  // object to scene).
+  void Match(size_t model, const Scene& scene, ViewCandidate* candidate) const {
+    if (candidate->matched) return;
+    const ModelView& view = records_[model].views[static_cast<size_t>(candidate->view)];
+    candidate->correspondences = Correspondences(view, view.descriptors, scene);
+    candidate->matched = true;
   }
 
   // The nearest scene primitive of each of `descriptors` (rows of the view's).
@@ -359,22 +402,31 @@ class Recognizer::Impl {
     return found;
   }
 
-  std::vector<Hypothesis> EstimatePoses(const ModelRecord& model, const std::vector<ViewCandidate>& views,
-                                        const Scene& scene) const {
-    std::vector<Hypothesis> hypotheses;
+  // Matches, RANSAC and verification of one view, once per frame (a later instance of the model reuses them).
+  void Try(size_t model, const Scene& scene, ViewCandidate* candidate, std::map<std::string, double>* timings_ms) {
+    if (candidate->tried) return;
+    candidate->tried = true;
+    Clock::time_point stage = Clock::now();
+    Match(model, scene, candidate);
+    (*timings_ms)["match"] += MillisecondsSince(stage);
+
+    stage = Clock::now();
+    const ModelRecord& record = records_[model];
     RansacOptions ransac = options_.ransac;
-    ransac.sample_radius_m = options_.sample_radius_diameters * model.diameter_m;
-    for (const ViewCandidate& candidate : views) {
-      const ModelView& view = model.views[static_cast<size_t>(candidate.view)];
-      const std::vector<Eigen::Vector3f> object_points = PrimitivePositions(view.primitives);
-      Hypothesis hypothesis;
-      hypothesis.view = candidate.view;
-      hypothesis.ransac =
-          EstimatePoseRansac(object_points, scene.ransac_points, candidate.correspondences, ransac, &scene.visibility);
-      hypothesis.pose = hypothesis.ransac.scene_from_object;
-      if (hypothesis.ransac.success) hypotheses.push_back(hypothesis);
-    }
-    return hypotheses;
+    ransac.sample_radius_m = options_.sample_radius_diameters * record.diameter_m;
+    Hypothesis hypothesis;
+    hypothesis.view = candidate->view;
+    hypothesis.ransac =
+        EstimatePoseRansac(PrimitivePositions(record.views[static_cast<size_t>(candidate->view)].primitives),
+                           scene.ransac_points, candidate->correspondences, ransac, &scene.visibility);
+    hypothesis.pose = hypothesis.ransac.scene_from_object;
+    (*timings_ms)["ransac"] += MillisecondsSince(stage);
+    if (!hypothesis.ransac.success) return;
+
+    stage = Clock::now();
+    candidate->verified = Verify(model, scene, hypothesis);
+    candidate->hypothesis = hypothesis;
+    (*timings_ms)["verify"] += MillisecondsSince(stage);
   }
 
   // Point-to-plane ICP of the model's surface as rendered at the pose (`rendered_depth`, from Verify) against

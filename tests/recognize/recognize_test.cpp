@@ -1,5 +1,6 @@
 // End to end: a library of the three textured YCB meshes in models/ built with `ecvpose modeldb build`, then
-// `ecvpose recognize` and `ecvpose eval` on the real YCB-Video frame in models/frame.
+// `ecvpose recognize` and `ecvpose eval` on the real YCB-Video frame in models/frame (and on that frame with a
+// second mustard bottle pasted in from another real frame).
 
 #include <algorithm>
 #include <cmath>
@@ -149,6 +150,43 @@ TEST_F(RecognizeEndToEnd, AFirstDetectionBelowTheTrackStartScoreIsNotFollowed) {
   EXPECT_EQ(kept.scene_primitives, 0);
 }
 
+// The demo frame (video 0001) with the mustard bottle of video 0002's first frame pasted in over the cracker box,
+// at its ground-truth pose (PasteYcbvObject): two instances of one model on real pixels.
+TEST_F(RecognizeEndToEnd, FindsBothOfTwoMustardBottlesWhenAskedForTwoInstances) {
+  const LoadedFrame scene = PasteYcbvObject(
+      LoadYcbvFrame(Frame()), test::DataPath("ycbv_subset/Example-Scenes/0002/000001"), "006_mustard_bottle");
+  const std::string frame = directory_->File("two_bottles.json");
+  WriteFrameJson(frame, scene.rgbd);
+  LibraryLoadOptions load;
+  load.build_matchers = false;
+  const ModelLibrary library = ModelLibrary::Load(library_, load);
+  std::vector<EvalModel> models;
+  for (const LibraryModel& model : library.models()) models.push_back(EvalModelFromRecord(model.record));
+  auto bottles = [&](const std::string& flags, FrameEvaluation* evaluation) {
+    const std::string json = directory_->File("two_bottles_detections.json");
+    const test::CommandResult run =
+        test::RunCli("recognize --db " + library_ + " " + frame + " --out-json " + json + flags);
+    EXPECT_EQ(run.exit_code, 0) << run.output;
+    const std::vector<Detection> detections = DetectionsFromJson(ReadJsonFile(json), json);
+    *evaluation = EvaluateFrame("two bottles", detections, scene.ground_truth, models);
+    return std::count_if(detections.begin(), detections.end(),
+                         [](const Detection& detection) { return detection.model == "006_mustard_bottle"; });
+  };
+  FrameEvaluation one, two;
+  EXPECT_EQ(bottles("", &one), 1) << "one instance per model by default";
+  ASSERT_EQ(bottles(" --max-instances 2", &two), 2);
+  // Each bottle is found near its pose. Over RANSAC seeds 1-10 the pasted one was found in 9 runs, at 2-3 mm
+  // and 5-10 degrees in 5 and at 11-12 mm and 16-17 degrees in 4 (ADD 19-20 mm, about 0.1 d: there ICP's better
+  // pose scored lower, as video 0002's colours lie a few pixels off its depth; bench/RESULTS.md, session 8).
+  ASSERT_EQ(two.objects.size(), 4U);  // the master chef can is not in the library
+  for (const ObjectEvaluation& object : two.objects) {
+    if (object.model != "006_mustard_bottle") continue;
+    EXPECT_TRUE(object.detected);
+    EXPECT_LT(object.error.translation_mm, 15.0);
+    EXPECT_LT(object.error.rotation_deg, 20.0);
+  }
+}
+
 TEST_F(RecognizeEndToEnd, BadInputIsReported) {
   const test::CommandResult missing_db = test::RunCli("recognize --db /nonexistent/lib.sqlite " + Frame());
   EXPECT_EQ(missing_db.exit_code, 1) << missing_db.output;
@@ -185,6 +223,12 @@ TEST(RecognizerOptions, OutOfRangeValuesAreReportedByName) {
   options = RecognizerOptions();
   options.min_score = 1.5;
   EXPECT_NE(message(options).find("min_score"), std::string::npos) << message(options);
+  options = RecognizerOptions();
+  options.max_instances = 0;
+  EXPECT_NE(message(options).find("max_instances"), std::string::npos) << message(options);
+  options = RecognizerOptions();
+  options.later_instance_views = -1;
+  EXPECT_NE(message(options).find("later_instance_views"), std::string::npos) << message(options);
 }
 
 }  // namespace
