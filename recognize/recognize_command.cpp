@@ -12,6 +12,7 @@
 #include "app/frame_args.h"
 #include "core/error.h"
 #include "core/pose.h"
+#include "core/timing.h"
 #include "io/frame_io.h"
 #include "io/pose_io.h"
 #include "modeldb/model_library.h"
@@ -116,7 +117,9 @@ int RunRecognize(const RecognizeArgs& args) {
   const ModelLibrary library = ModelLibrary::Load(args.db, load);
   std::cerr << "recognize: " << library.models().size() << " models, " << library.NumViews() << " views from "
             << args.db << " (" << std::fixed << std::setprecision(0) << library.timings().read_ms << " ms)\n";
+  const Clock::time_point setup = Clock::now();
   Recognizer recognizer(library, args.options);
+  std::cerr << "recognize: meshes loaded for verification (" << MillisecondsSince(setup) << " ms)\n";
 
   if (frames.empty()) {  // one frame
     const LoadedFrame loaded = app::LoadFrameWithWarnings(args.frame);
@@ -204,6 +207,10 @@ CommandAction SetupRecognizeCommand(CLI::App& command) {
   RecognizerOptions& options = args->options;
   options.ransac.threads = app::AllCores();
   command.add_option("--views-per-model", options.views_per_model, "Library views tried with RANSAC per model")
+      ->capture_default_str();
+  command
+      .add_option("--good-enough-score", options.good_enough_score,
+                  "A model's remaining views are skipped once one verifies at this score (0: try them all)")
       ->capture_default_str();
   command.add_option("--min-score", options.min_score, "Detections below this score are dropped")
       ->capture_default_str();

@@ -5,6 +5,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <exception>
+#include <functional>
+#include <mutex>
 #include <numeric>
 #include <optional>
 #include <random>
@@ -86,6 +89,30 @@ struct ViewCandidate {
   std::optional<Verified> verified;
 };
 
+// Calls work(i) for every i in [0, count) on `threads` threads, this one included, and waits for them; the
+// first exception thrown is rethrown here.
+void ParallelFor(size_t count, int threads, const std::function<void(size_t)>& work) {
+  std::atomic<size_t> next{0};
+  std::exception_ptr failure;
+  std::mutex failure_mutex;
+  auto run = [&] {
+    for (size_t i = next++; i < count; i = next++) {
+      try {
+        work(i);
+      } catch (...) {
+        const std::lock_guard<std::mutex> lock(failure_mutex);
+        if (!failure) failure = std::current_exception();
+        next = count;
+      }
+    }
+  };
+  std::vector<std::thread> workers;
+  for (size_t t = 1; t < std::min(count, static_cast<size_t>(threads)); ++t) workers.emplace_back(run);
+  run();
+  for (std::thread& worker : workers) worker.join();
+  if (failure) std::rethrow_exception(failure);
+}
+
 // Marks on `covered` (CV_8UC1, the frame's size) the pixels of a verified surface, sampled every `stride`
 // pixels, with the gaps between the samples closed.
 void CoverSurface(const std::vector<cv::Point>& surface, int stride, cv::Mat* covered) {
@@ -135,6 +162,7 @@ void RecognizerOptions::Check() const {
     if (!ok) ThrowInputError("recognizer options", field, expected);
   };
   require(views_per_model >= 1, "views_per_model", "at least 1");
+  require(good_enough_score >= 0.0, "good_enough_score", ">= 0 (0: try every ranked view)");
   consistency.Check();
   plane_patch.Check();
   require(consistency_max_correspondences >= 3, "consistency_max_correspondences", "at least 3");
@@ -152,33 +180,30 @@ void RecognizerOptions::Check() const {
   require(min_score >= 0.0 && min_score <= 1.0, "min_score", "in [0, 1]");
   require(min_track_start_score >= 0.0 && min_track_start_score <= 1.0, "min_track_start_score", "in [0, 1]");
   require(min_visible_fraction >= 0.0 && min_visible_fraction <= 1.0, "min_visible_fraction", "in [0, 1]");
+  require(max_texture_size >= 1, "max_texture_size", "at least 1 pixel");
 }
 
 class Recognizer::Impl {
  public:
-  Impl(const ModelLibrary& library, const RecognizerOptions& options) : library_(library), options_(options) {
-    options_.Check();
+  Impl(const ModelLibrary& library, const RecognizerOptions& options)
+      : library_(library), options_(options), renderer_(VerificationRenderer(options)) {
     options_.match.k = 1;
-    for (const LibraryModel& model : library_.models()) {
-      // With a colour matrix, the views' colours are mapped into the scene camera's colours and their
-      // descriptors recomputed (paper Sect. IV-C: A c_model = c_scene before matching).
-      records_.push_back(model.record);
-      ModelRecord& record = records_.back();
-      if (options_.use_color_matrix && model.color_matrix) {
-        // Scaled to keep grey's brightness: a gain below 1 shrinks the colour differences the descriptor bins,
-        // which are not smaller in real frames (bench/RESULTS.md, colour calibration). Matrices stored by
-        // `ecvpose colorcal` keep the brightness already; this covers --no-keep-brightness and older libraries.
-        const Eigen::Matrix3d to_scene = BrightnessPreserving(model.color_matrix->model_to_scene);
-        for (ModelView& view : record.views) {
-          ApplyColorMatrix(to_scene, &view.primitives);
-          view.descriptors = ComputeDescriptors(view.primitives, library_.feature_settings().descriptor);
-        }
-      }
-      MeshLoadOptions load;
-      load.metres_per_unit = MetresPerUnit(record.unit);
-      load.object_from_mesh = record.object_from_mesh;
-      load.allow_missing_textures = true;
-      meshes_.push_back(renderer_.AddMesh(LoadMesh(record.mesh_path, load)));
+    const std::vector<LibraryModel>& models = library_.models();
+    records_.resize(models.size());
+    // Colour mapping, mesh files and texture decoding on every thread, a batch of models at a time (only a
+    // batch's meshes are held at once); the GL uploads on this thread, whose GL context it is.
+    const size_t batch = static_cast<size_t>(options_.ransac.threads);
+    for (size_t first = 0; first < models.size(); first += batch) {
+      std::vector<TriangleMesh> meshes(std::min(batch, models.size() - first));
+      ParallelFor(meshes.size(), options_.ransac.threads, [&](size_t i) {
+        records_[first + i] = PreparedRecord(models[first + i]);
+        MeshLoadOptions load;
+        load.metres_per_unit = MetresPerUnit(records_[first + i].unit);
+        load.object_from_mesh = records_[first + i].object_from_mesh;
+        load.allow_missing_textures = true;
+        meshes[i] = LoadMesh(records_[first + i].mesh_path, load);
+      });
+      for (const TriangleMesh& mesh : meshes) meshes_.push_back(renderer_.AddMesh(mesh));
     }
   }
 
@@ -320,6 +345,9 @@ class Recognizer::Impl {
       if (best_view == nullptr || candidate.verified->detection.score > best_view->verified->detection.score) {
         best_view = &candidate;
       }
+      if (options_.good_enough_score > 0.0 && best_view->verified->detection.score >= options_.good_enough_score) {
+        break;
+      }
     }
     if (best_view == nullptr) return std::nullopt;
     std::optional<Verified> best = best_view->verified;
@@ -342,17 +370,9 @@ class Recognizer::Impl {
   // model's ranking depends on nothing else, so the result does not depend on the count).
   std::vector<std::vector<ViewCandidate>> RankAllViews(const Scene& scene, const std::vector<bool>& skip) const {
     std::vector<std::vector<ViewCandidate>> ranked(records_.size());
-    std::atomic<size_t> next{0};
-    auto work = [&] {
-      for (size_t m = next++; m < records_.size(); m = next++) {
-        if (!skip[m]) ranked[m] = RankViews(m, scene);
-      }
-    };
-    std::vector<std::thread> workers;
-    const size_t threads = std::min(records_.size(), static_cast<size_t>(options_.ransac.threads));
-    for (size_t t = 1; t < threads; ++t) workers.emplace_back(work);
-    work();
-    for (std::thread& worker : workers) worker.join();
+    ParallelFor(records_.size(), options_.ransac.threads, [&](size_t m) {
+      if (!skip[m]) ranked[m] = RankViews(m, scene);
+    });
     return ranked;
   }
 
@@ -613,6 +633,29 @@ class Recognizer::Impl {
   }
 
  private:
+  static RendererOptions VerificationRenderer(const RecognizerOptions& options) {
+    options.Check();  // before anything is made of them
+    RendererOptions renderer;
+    renderer.max_texture_size = options.max_texture_size;
+    return renderer;
+  }
+
+  // The library's record of a model, its views' colours mapped by its colour matrix (if any and used) and their
+  // descriptors recomputed (paper Sect. IV-C: A c_model = c_scene before matching).
+  ModelRecord PreparedRecord(const LibraryModel& model) const {
+    ModelRecord record = model.record;
+    if (!options_.use_color_matrix || !model.color_matrix) return record;
+    // Scaled to keep grey's brightness: a gain below 1 shrinks the colour differences the descriptor bins, which
+    // are not smaller in real frames (bench/RESULTS.md, colour calibration). Matrices stored by `ecvpose colorcal`
+    // keep the brightness already; this covers --no-keep-brightness and older libraries.
+    const Eigen::Matrix3d to_scene = BrightnessPreserving(model.color_matrix->model_to_scene);
+    for (ModelView& view : record.views) {
+      ApplyColorMatrix(to_scene, &view.primitives);
+      view.descriptors = ComputeDescriptors(view.primitives, library_.feature_settings().descriptor);
+    }
+    return record;
+  }
+
   const ModelLibrary& library_;
   RecognizerOptions options_;
   std::vector<ModelRecord> records_;  // per model: the library's, colours mapped by its colour matrix if any

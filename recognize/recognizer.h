@@ -30,6 +30,10 @@ struct RecognizerOptions {
   /// have a library view with 6 or more right correspondences among its 200 ranking ones, and such a view is
   /// among the best-ranked 5 for 56 of them (session 7, scratch study).
   int views_per_model = 7;
+  /// A model's remaining ranked views are not tried once one verifies at or above this score (0: always try
+  /// views_per_model). On the 30 YCB-Video frames (seeds 1/2/3) 0.5 found the same 49/47/46 of 70 objects with
+  /// the same false positives, in 1433/1403/1413 instead of 1620/1563/1569 ms per frame (median, one thread).
+  double good_enough_score = 0.5;
   /// The scene's descriptors take at most this many neighbours (spread over the distance ranks, see
   /// DescriptorOptions::max_neighbours) when the library's setting allows more; 0 keeps the library's.
   /// Pairs grow with its square, so it bounds the describe time of close-ups: on the 10 close-ups of YCB-Video
@@ -119,6 +123,11 @@ struct RecognizerOptions {
   /// Apply a model's stored colour matrix (when it has one) to its view colours before matching (the views'
   /// descriptors are recomputed once, when the Recognizer is made) and to its rendered colours in verification.
   bool use_color_matrix = true;
+  /// Textures larger than this (pixels per side) are downscaled for verification renders, where a model covers a
+  /// few hundred pixels. YCB's 4096 x 4096 textures (decoded, uploaded, mipmapped) took most of the Recognizer's
+  /// set-up: with 7 YCB models, 1764 ms at 2048 against 2341 ms uncapped (one thread). On the 30 YCB-Video
+  /// frames 2048 found the same 49 of 70 objects as no cap; 1024 (1650 ms) lost a banana scored 0.380.
+  int max_texture_size = 2048;
 
   static RansacOptions DefaultRansac();
   /// 32 checks instead of 128: on 15 YCB-Video frames the same recall, and matching 2.2x faster. Approximate

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 #include <gtest/gtest.h>
 
@@ -198,6 +199,26 @@ TEST_F(RecognizeEndToEnd, BadInputIsReported) {
   EXPECT_EQ(no_db.exit_code, 2) << no_db.output;
 }
 
+// The meshes are read again when a Recognizer is made (for verification renders), on worker threads: a mesh file
+// gone since the library was built is an error naming it, raised from whichever thread read it.
+TEST(RecognizeCli, AMeshGoneSinceTheLibraryWasBuiltIsNamed) {
+  const test::TemporaryDirectory directory;
+  const std::filesystem::path meshes = directory.File("meshes");
+  std::filesystem::copy(std::string(ECV_SOURCE_DIR) + "/models/meshes", meshes,
+                        std::filesystem::copy_options::recursive);
+  const std::string library = directory.File("library.sqlite");
+  const test::CommandResult build =
+      test::RunCli("modeldb build " + meshes.string() + " --views 4 --distance 0.9 --db " + library);
+  ASSERT_EQ(build.exit_code, 0) << build.output;
+  const std::filesystem::path gone = meshes / "004_sugar_box" / "004_sugar_box.obj";
+  ASSERT_TRUE(std::filesystem::remove(gone));
+
+  const test::CommandResult run = test::RunCli("recognize --db " + library + " --threads 2 " +
+                                               std::string(ECV_SOURCE_DIR) + "/models/frame/000001");
+  EXPECT_NE(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find(gone.string()), std::string::npos) << run.output;
+}
+
 TEST(RecognizerOptions, OutOfRangeValuesAreReportedByName) {
   EXPECT_NO_THROW(RecognizerOptions().Check());
   auto message = [](const RecognizerOptions& options) {
@@ -229,6 +250,12 @@ TEST(RecognizerOptions, OutOfRangeValuesAreReportedByName) {
   options = RecognizerOptions();
   options.later_instance_views = -1;
   EXPECT_NE(message(options).find("later_instance_views"), std::string::npos) << message(options);
+  options = RecognizerOptions();
+  options.max_texture_size = 0;
+  EXPECT_NE(message(options).find("max_texture_size"), std::string::npos) << message(options);
+  options = RecognizerOptions();
+  options.good_enough_score = -0.1;
+  EXPECT_NE(message(options).find("good_enough_score"), std::string::npos) << message(options);
 }
 
 }  // namespace
