@@ -43,23 +43,31 @@ struct Scene {
   SceneVisibility visibility;
 };
 
-// At most `count` rows of `descriptors`, drawn at random (seeded) when there are more.
-Descriptors SampleRows(const Descriptors& descriptors, size_t count, uint64_t seed) {
+// The given rows of `descriptors`, in that order.
+Descriptors CopyRows(const Descriptors& descriptors, const std::vector<int>& rows) {
+  Descriptors copy;
+  copy.values.create(static_cast<int>(rows.size()), descriptors.values.cols, descriptors.values.type());
+  for (size_t i = 0; i < rows.size(); ++i) {
+    descriptors.values.row(rows[i]).copyTo(copy.values.row(static_cast<int>(i)));
+    copy.primitive.push_back(descriptors.primitive[static_cast<size_t>(rows[i])]);
+  }
+  return copy;
+}
+
+// A seeded random subset of `count` rows of `descriptors` (all of them when there are no more) and the other
+// rows, each in row order.
+std::pair<Descriptors, Descriptors> SplitRows(const Descriptors& descriptors, size_t count, uint64_t seed) {
   const size_t rows = static_cast<size_t>(descriptors.values.rows);
-  if (rows <= count) return descriptors;
+  if (rows <= count) return {descriptors, CopyRows(descriptors, {})};
   std::vector<int> order(rows);
   std::iota(order.begin(), order.end(), 0);
   std::mt19937_64 random(seed);
   std::shuffle(order.begin(), order.end(), random);
+  std::vector<int> rest(order.begin() + static_cast<std::ptrdiff_t>(count), order.end());
   order.resize(count);
   std::sort(order.begin(), order.end());
-  Descriptors subset;
-  subset.values.create(static_cast<int>(count), descriptors.values.cols, descriptors.values.type());
-  for (size_t i = 0; i < count; ++i) {
-    descriptors.values.row(order[i]).copyTo(subset.values.row(static_cast<int>(i)));
-    subset.primitive.push_back(descriptors.primitive[static_cast<size_t>(order[i])]);
-  }
-  return subset;
+  std::sort(rest.begin(), rest.end());
+  return {CopyRows(descriptors, order), CopyRows(descriptors, rest)};
 }
 
 // A verified pose: the detection, the pixels (at dense_stride_px) where its rendered surface lies on the
@@ -82,9 +90,10 @@ struct Hypothesis {
 struct ViewCandidate {
   int view = -1;
   int score = 0;
-  bool matched = false;                         // `correspondences` are there
-  std::vector<Correspondence> correspondences;  // the nearest scene primitive of each of its descriptors
-  bool tried = false;                           // RANSAC ran on it (and `verified` is its pose, if any)
+  // The nearest scene primitive of each of its descriptors once `matched`; before, of its ranking subset only.
+  std::vector<Correspondence> correspondences;
+  bool matched = false;
+  bool tried = false;  // RANSAC ran on it (and `verified` is its pose, if any)
   std::optional<Hypothesis> hypothesis;
   std::optional<Verified> verified;
 };
@@ -387,12 +396,10 @@ class Recognizer::Impl {
       ViewCandidate candidate;
       candidate.view = static_cast<int>(v);
       // Scored on a seeded subset of the view's descriptors, for speed.
-      const Descriptors subset = SampleRows(
-          view.descriptors, static_cast<size_t>(options_.consistency_max_correspondences), options_.ransac.seed + v);
+      candidate.correspondences = Correspondences(view, RankingRows(model, v).first, scene);
       ConsistencyOptions consistency = options_.consistency;
       consistency.max_distance_m = record.diameter_m;
-      candidate.score =
-          ConsistentSetSize(view.primitives, scene.primitives, Correspondences(view, subset, scene), consistency);
+      candidate.score = ConsistentSetSize(view.primitives, scene.primitives, candidate.correspondences, consistency);
       views.push_back(std::move(candidate));
     }
     std::stable_sort(views.begin(), views.end(),
@@ -403,12 +410,26 @@ class Recognizer::Impl {
     return views;
   }
 
+  // A view's ranking subset of descriptors (consistency_max_correspondences of them) and the other rows.
+  std::pair<Descriptors, Descriptors> RankingRows(size_t model, size_t view) const {
+    return SplitRows(records_[model].views[view].descriptors,
+                     static_cast<size_t>(options_.consistency_max_correspondences), options_.ransac.seed + view);
+  }
+
   // Gives `candidate` its correspondences, once: the nearest scene descriptor of each of its descriptors (paper:
-  // object to scene).
+  // object to scene). The ranking has matched a subset of them; only the others are searched here, and the
+  // correspondences are put in the order in which matching all the rows at once gives them (MatchOrderLess), so
+  // that RANSAC draws the same samples.
   void Match(size_t model, const Scene& scene, ViewCandidate* candidate) const {
     if (candidate->matched) return;
-    const ModelView& view = records_[model].views[static_cast<size_t>(candidate->view)];
-    candidate->correspondences = Correspondences(view, view.descriptors, scene);
+    const auto view = static_cast<size_t>(candidate->view);
+    const ModelView& model_view = records_[model].views[view];
+    std::vector<Correspondence> found = Correspondences(model_view, RankingRows(model, view).second, scene);
+    found.insert(found.end(), candidate->correspondences.begin(), candidate->correspondences.end());
+    std::sort(found.begin(), found.end(), [&](const Correspondence& a, const Correspondence& b) {
+      return MatchOrderLess(model_view.primitives, options_.match.structure_specific, a.object, b.object);
+    });
+    candidate->correspondences = std::move(found);
     candidate->matched = true;
   }
 

@@ -30,7 +30,7 @@ void SelectRows(const Descriptors& descriptors, Keep keep, cv::Mat* values, std:
   for (size_t row = 0; row < descriptors.primitive.size(); ++row) {
     if (keep(descriptors.primitive[row])) rows.push_back(static_cast<int>(row));
   }
-  values->create(static_cast<int>(rows.size()), kDescriptorSize, CV_32F);
+  values->create(static_cast<int>(rows.size()), descriptors.values.cols, CV_32F);
   primitive->clear();
   for (size_t i = 0; i < rows.size(); ++i) {
     descriptors.values.row(rows[i]).copyTo(values->row(static_cast<int>(i)));
@@ -105,6 +105,15 @@ std::vector<DescriptorMatch> DescriptorMatcher::Match(const std::vector<Primitiv
     }
   }
   return matches;
+}
+
+bool MatchOrderLess(const std::vector<Primitive>& query_primitives, bool structure_specific, int a, int b) {
+  if (structure_specific) {
+    const auto type_a = static_cast<int>(query_primitives[static_cast<size_t>(a)].type);
+    const auto type_b = static_cast<int>(query_primitives[static_cast<size_t>(b)].type);
+    if (type_a != type_b) return type_a < type_b;
+  }
+  return a < b;
 }
 
 CorrespondenceScore ScoreCorrespondences(const std::vector<Primitive>& query, const std::vector<Primitive>& train,

@@ -38,7 +38,8 @@ class DescriptorMatcher {
   DescriptorMatcher(const DescriptorMatcher&) = delete;
   DescriptorMatcher& operator=(const DescriptorMatcher&) = delete;
 
-  /// The k nearest train descriptors of each query descriptor (of the same type when structure-specific).
+  /// The k nearest train descriptors of each query descriptor (of the same type when structure-specific), in
+  /// MatchOrderLess order: a query set matched in parts gives the same matches once sorted by it.
   std::vector<DescriptorMatch> Match(const std::vector<Primitive>& query_primitives, const Descriptors& query) const;
 
  private:
@@ -46,6 +47,10 @@ class DescriptorMatcher {
   MatchOptions options_;
   std::vector<std::unique_ptr<Index>> indices_;  // one per primitive type, or one for all
 };
+
+/// True when DescriptorMatcher::Match lists the matches of query primitive `a` before those of `b`: segments
+/// before texlets when structure-specific, then by primitive index (as ComputeDescriptors orders its rows).
+bool MatchOrderLess(const std::vector<Primitive>& query_primitives, bool structure_specific, int a, int b);
 
 /// The paper's correspondence score (Sect. IV-A) of some matches.
 struct CorrespondenceScore {

@@ -2,7 +2,9 @@
 // correspondence score of a real view against itself.
 
 #include <algorithm>
+#include <numeric>
 #include <random>
+#include <tuple>
 
 #include <gtest/gtest.h>
 
@@ -325,6 +327,50 @@ TEST(EcvMatching, RealViewAgainstItselfScoresOne) {
   EXPECT_GT(score.Score(), 0.99);
   EXPECT_NEAR(TruePartnerFraction(primitives, descriptors.primitive, primitives, Eigen::Isometry3d::Identity()), 1.0,
               1e-12);
+}
+
+// The recognizer matches a view's ranking subset first and the other rows later, and needs the merged matches
+// in the order of one Match call (its RANSAC draws samples by index).
+TEST(EcvMatching, MatchingInPartsGivesTheSameMatchesInMatchOrder) {
+  const LoadedFrame scene_frame = LoadYcbvFrame(test::DataPath("ycbv_subset/Example-Scenes/0001/000001"));
+  const LoadedFrame query_frame = LoadYcbvFrame(test::DataPath("ycbv_subset/Example-Scenes/0001/000019"));
+  const std::vector<Primitive> scene = ExtractPrimitives(scene_frame.rgbd).primitives;
+  const std::vector<Primitive> query = ExtractPrimitives(query_frame.rgbd).primitives;
+  const Descriptors all = ComputeDescriptors(query);
+  ASSERT_GT(all.values.rows, 1000);
+  std::vector<int> rows(static_cast<size_t>(all.values.rows));
+  std::iota(rows.begin(), rows.end(), 0);
+  std::shuffle(rows.begin(), rows.end(), std::mt19937(3));
+  const std::vector<int> first(rows.begin(), rows.begin() + 200), rest(rows.begin() + 200, rows.end());
+  auto part = [&](std::vector<int> part_rows) {
+    std::sort(part_rows.begin(), part_rows.end());
+    Descriptors some;
+    for (const int row : part_rows) {
+      some.values.push_back(all.values.row(row));
+      some.primitive.push_back(all.primitive[static_cast<size_t>(row)]);
+    }
+    return some;
+  };
+  for (const bool structure_specific : {true, false}) {
+    MatchOptions options;
+    options.structure_specific = structure_specific;
+    options.k = 2;
+    const DescriptorMatcher matcher(scene, ComputeDescriptors(scene), options);  // approximate: > exact_below rows
+    const std::vector<DescriptorMatch> whole = matcher.Match(query, all);
+    std::vector<DescriptorMatch> merged = matcher.Match(query, part(rest));
+    const std::vector<DescriptorMatch> ranked = matcher.Match(query, part(first));
+    merged.insert(merged.end(), ranked.begin(), ranked.end());
+    std::stable_sort(merged.begin(), merged.end(), [&](const DescriptorMatch& a, const DescriptorMatch& b) {
+      return MatchOrderLess(query, structure_specific, a.query, b.query);
+    });
+    ASSERT_EQ(merged.size(), whole.size()) << "structure_specific " << structure_specific;
+    for (size_t i = 0; i < whole.size(); ++i) {
+      ASSERT_EQ(std::tie(merged[i].query, merged[i].train, merged[i].rank),
+                std::tie(whole[i].query, whole[i].train, whole[i].rank))
+          << "match " << i << ", structure_specific " << structure_specific;
+      ASSERT_EQ(merged[i].distance, whole[i].distance);
+    }
+  }
 }
 
 }  // namespace
