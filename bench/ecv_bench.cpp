@@ -6,6 +6,7 @@
 #include <cstring>
 #include <iostream>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -92,29 +93,51 @@ std::string Row(const char* name, const std::vector<double>& values, double refe
          (reference > 0 ? Fixed(median / reference, 2) : "") + " |\n";
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+struct Settings {
   int runs = 3;
   std::string results = std::string(ECV_SOURCE_DIR) + "/bench/RESULTS.md";
-  for (int i = 1; i + 1 < argc; i += 2) {
-    if (std::strcmp(argv[i], "--runs") == 0) runs = std::stoi(argv[i + 1]);
-    if (std::strcmp(argv[i], "--results") == 0) results = argv[i + 1];
+};
+
+// Throws std::invalid_argument naming the flag that is unknown, lacks its value or has a bad one.
+Settings ParseArguments(int argc, char** argv) {
+  Settings settings;
+  for (int i = 1; i < argc; ++i) {
+    const std::string flag = argv[i];
+    if (flag != "--runs" && flag != "--results") throw std::invalid_argument("unknown flag " + flag);
+    if (i + 1 >= argc) throw std::invalid_argument(flag + " needs a value");
+    const std::string value = argv[++i];
+    if (flag == "--results") {
+      settings.results = value;
+      continue;
+    }
+    std::size_t used = 0;
+    try {
+      settings.runs = std::stoi(value, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != value.size() || settings.runs < 1) {
+      throw std::invalid_argument("--runs expects a positive integer, got '" + value + "'");
+    }
   }
+  return settings;
+}
+
+std::string Measure(const Settings& settings) {
   Timings timings;
   int frames = 0;
   for (const char* video : {"0000", "0001", "0002"}) {
     for (int number = 1; number <= 19; number += 2) {
       char prefix[256];
       std::snprintf(prefix, sizeof(prefix), "%s/ycbv_subset/Example-Scenes/%s/%06d", ECV_DATA_DIR, video, number);
-      MeasureFrame(ecv::LoadYcbvFrame(prefix).rgbd, runs, &timings);
+      MeasureFrame(ecv::LoadYcbvFrame(prefix).rgbd, settings.runs, &timings);
       std::cerr << "\rframe " << ++frames << "/30" << std::flush;
     }
   }
   std::cerr << '\n';
   const double total = Median(timings.total);
   std::string table = "Median over " + std::to_string(frames) + " real YCB-Video frames (640x480), best of " +
-                      std::to_string(runs) +
+                      std::to_string(settings.runs) +
                       " runs each; ratio = time / ECV total.\n\n"
                       "| step | ms | ratio |\n|---|---:|---:|\n";
   table += Row("monogenic signal (FFT, log-Gabor, Riesz)", timings.monogenic, total);
@@ -131,6 +154,25 @@ int main(int argc, char** argv) {
   table += "\nPrimitives per frame (median): " + Fixed(Median(timings.segments), 0) + " segments, " +
            Fixed(Median(timings.texlets), 0) + " texlets; SIFT keypoints: " + Fixed(Median(timings.sift_count), 0) +
            ".\n";
-  ecv::bench::Report(results, "ECV primitive extraction", ecv::bench::CommandLine(argc, argv), table);
+  return table;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Settings settings;
+  try {
+    settings = ParseArguments(argc, argv);
+  } catch (const std::invalid_argument& error) {
+    std::cerr << "ecv_bench: " << error.what() << "\nusage: ecv_bench [--runs N] [--results FILE]\n";
+    return 2;
+  }
+  try {
+    const std::string table = Measure(settings);
+    ecv::bench::Report(settings.results, "ECV primitive extraction", ecv::bench::CommandLine(argc, argv), table);
+  } catch (const std::exception& error) {
+    std::cerr << "ecv_bench: " << error.what() << '\n';
+    return 1;
+  }
   return 0;
 }

@@ -15,21 +15,6 @@
 namespace ecv {
 namespace {
 
-// Adds `weight` at `value` to a histogram of `bins` bins over [low, 1].
-void AddToHistogram(float value, float low, bool soft, float weight, int bins, float* histogram) {
-  const float position = (value - low) / (1.0F - low) * static_cast<float>(bins) - 0.5F;  // bin centres at integers
-  if (!soft) {
-    const int bin = std::clamp(static_cast<int>(std::max(position, -0.5F) + 0.5F), 0, bins - 1);
-    histogram[bin] += weight;
-    return;
-  }
-  const float clamped = std::clamp(position, 0.0F, static_cast<float>(bins - 1));
-  const int lower = std::min(static_cast<int>(clamped), bins - 2);
-  const float upper_share = clamped - static_cast<float>(lower);
-  histogram[lower] += weight * (1.0F - upper_share);
-  histogram[lower + 1] += weight * upper_share;
-}
-
 // Colours scaled per channel so that their mean is 0.5 (grey world), clamped to [0, 1].
 std::vector<Primitive> BalanceColors(std::vector<Primitive> primitives) {
   Eigen::Vector3f mean = Eigen::Vector3f::Zero();
@@ -77,76 +62,135 @@ AppearanceValues ComputeAppearance(const std::vector<Primitive>& primitives, Des
   return appearance;
 }
 
-// The context of one source: its primitives, appearance values and histogramming options.
-struct Context {
-  const std::vector<Primitive>& primitives;
-  const AppearanceValues& appearance;
-  const DescriptorOptions& options;
-};
-
-// Adds the pair {a, b} (a the closer to the source) with `weight` to the six histograms, in their radial
-// `shell` (0 .. shells - 1) when they are split into radial shells.
-void AddPair(const Context& context, int a_index, int b_index, float weight, int shell, float* descriptor) {
-  const Primitive& a = context.primitives[static_cast<size_t>(a_index)];
-  const Primitive& b = context.primitives[static_cast<size_t>(b_index)];
-  const Eigen::Vector3f offset = b.position - a.position;
-  const float length = offset.norm();
-  if (length <= 0.0F || weight <= 0.0F) return;
-  const DescriptorOptions& options = context.options;
-  const Eigen::Vector3f d = offset / length;
-  float cosines[3] = {a.orientation.dot(b.orientation), a.orientation.dot(d), b.orientation.dot(d)};
-  if (options.unsigned_segments) {
-    for (float& cosine : cosines) cosine = std::abs(cosine);
+// The six histograms of one source's context. Its members are gathered into contiguous arrays first: the
+// pair loop reads each of them once per pair, and the scene's dense contexts have up to 128 members.
+class ContextHistograms {
+ public:
+  ContextHistograms(const AppearanceValues& appearance, const DescriptorOptions& options)
+      : appearance_(appearance),
+        options_(options),
+        bins_(kDescriptorBins / options.shells),
+        histograms_(options.use_color ? 6 : 3) {
+    // Value k of a pair lies in [low_k, 1]; (value - low_k) * scale_k is its position in bins. Both factors
+    // of the scale are powers of two, so this equals (value - low_k) / (1 - low_k) * bins exactly.
+    const float cosine_low = options.unsigned_segments ? 0.0F : -1.0F;
+    for (int k = 0; k < 6; ++k) {
+      low_[k] = k < 3 ? cosine_low : -1.0F;
+      scale_[k] = static_cast<float>(bins_) / (1.0F - low_[k]);
+    }
   }
-  const float cosine_low = options.unsigned_segments ? 0.0F : -1.0F;
-  const int bins = kDescriptorBins / options.shells;
-  descriptor += shell * bins;
-  for (int k = 0; k < 3; ++k)
-    AddToHistogram(cosines[k], cosine_low, options.soft_binning, weight, bins, descriptor + k * kDescriptorBins);
-  if (!options.use_color) return;
-  const AppearanceValues& values = context.appearance;
-  const Eigen::Vector3f difference =
-      values.values[static_cast<size_t>(b_index)] - values.values[static_cast<size_t>(a_index)];
-  for (int k = 0; k < 3; ++k) {
-    float value = difference[k];
-    if (values.period[k] > 0.0F) value -= values.period[k] * std::floor(value / values.period[k] + 0.5F);
-    AddToHistogram(value * values.scale[k], -1.0F, options.soft_binning, weight, bins,
-                   descriptor + (3 + k) * kDescriptorBins);
-  }
-}
 
-// Histograms of the pairs of `neighbours` (indices into primitives, sorted by distance to the source,
-// `distances` from it in metres), all pairs or those with the source, then normalised.
-void DescribeContext(const Context& context, int source, const std::vector<int>& neighbours,
-                     const std::vector<float>& distances, float* descriptor) {
-  std::fill(descriptor, descriptor + kDescriptorSize, 0.0F);
-  const DescriptorOptions& options = context.options;
-  const float falloff = static_cast<float>(options.closeness_weight / options.radius_m);
-  const float inverse_squared_radius = static_cast<float>(1.0 / (options.radius_m * options.radius_m));
-  auto shell = [&](size_t j) {  // shells of equal area: by the squared distance from the source
-    const float share = distances[j] * distances[j] * inverse_squared_radius;
-    return std::min(static_cast<int>(share * static_cast<float>(options.shells)), options.shells - 1);
+  // Fills `descriptor` with the normalised histograms of the pairs of `neighbours` (indices into primitives,
+  // sorted by distance to `source`, `distances` from it in metres): all pairs or those with the source.
+  void Describe(const std::vector<Primitive>& primitives, int source, const std::vector<int>& neighbours,
+                const std::vector<float>& distances, float* descriptor) {
+    Gather(primitives, neighbours, distances);
+    std::fill(descriptor, descriptor + kDescriptorSize, 0.0F);
+    const size_t count = neighbours.size();
+    if (options_.pairs == DescriptorPairs::kSource) {
+      const Member member = MemberOf(primitives[static_cast<size_t>(source)], source);
+      for (size_t j = 0; j < count; ++j) {
+        if (neighbours[j] != source) AddPair(member, j, descriptor);
+      }
+    } else {
+      for (size_t i = 0; i < count; ++i) {
+        const Member member{position_[i], orientation_[i], appearance_values_[i]};
+        for (size_t j = i + 1; j < count; ++j) AddPair(member, j, descriptor);
+      }
+    }
+    Normalise(descriptor);
+  }
+
+ private:
+  struct Member {
+    Eigen::Vector3f position, orientation, appearance;
   };
-  if (options.pairs == DescriptorPairs::kSource) {
+
+  Member MemberOf(const Primitive& primitive, int index) const {
+    return {primitive.position, primitive.orientation, appearance_.values[static_cast<size_t>(index)]};
+  }
+
+  void Gather(const std::vector<Primitive>& primitives, const std::vector<int>& neighbours,
+              const std::vector<float>& distances) {
+    const float falloff = static_cast<float>(options_.closeness_weight / options_.radius_m);
+    const float inverse_squared_radius = static_cast<float>(1.0 / (options_.radius_m * options_.radius_m));
+    position_.clear();
+    orientation_.clear();
+    appearance_values_.clear();
+    weight_.clear();
+    shell_offset_.clear();
     for (size_t j = 0; j < neighbours.size(); ++j) {
-      if (neighbours[j] != source)
-        AddPair(context, source, neighbours[j], 1.0F - falloff * distances[j], shell(j), descriptor);
-    }
-  } else {
-    for (size_t i = 0; i < neighbours.size(); ++i) {
-      for (size_t j = i + 1; j < neighbours.size(); ++j)
-        AddPair(context, neighbours[i], neighbours[j], 1.0F - falloff * distances[j], shell(j), descriptor);
-    }
-  }
-  for (int h = 0; h < 6; ++h) {
-    float* histogram = descriptor + h * kDescriptorBins;
-    const float sum = std::accumulate(histogram, histogram + kDescriptorBins, 0.0F);
-    if (sum <= 0.0F) continue;
-    for (int bin = 0; bin < kDescriptorBins; ++bin) {
-      histogram[bin] = options.hellinger ? std::sqrt(histogram[bin] / sum) : histogram[bin] / sum;
+      const Member member = MemberOf(primitives[static_cast<size_t>(neighbours[j])], neighbours[j]);
+      position_.push_back(member.position);
+      orientation_.push_back(member.orientation);
+      appearance_values_.push_back(member.appearance);
+      // A pair is weighted, and put in a radial shell, by its member farther from the source; the shells
+      // have equal areas: by the squared distance from the source.
+      weight_.push_back(1.0F - falloff * distances[j]);
+      const float share = distances[j] * distances[j] * inverse_squared_radius;
+      const int shell = std::min(static_cast<int>(share * static_cast<float>(options_.shells)), options_.shells - 1);
+      shell_offset_.push_back(shell * bins_);
     }
   }
-}
+
+  // Adds the pair {a, member j} (a the closer to the source) to the six histograms.
+  void AddPair(const Member& a, size_t j, float* descriptor) const {
+    const float weight = weight_[j];
+    const Eigen::Vector3f offset = position_[j] - a.position;
+    const float length = offset.norm();
+    if (length <= 0.0F || weight <= 0.0F) return;
+    const Eigen::Vector3f d = offset / length;
+    const Eigen::Vector3f& b_orientation = orientation_[j];
+    float values[6] = {a.orientation.dot(b_orientation), a.orientation.dot(d), b_orientation.dot(d)};
+    if (options_.unsigned_segments) {
+      for (int k = 0; k < 3; ++k) values[k] = std::abs(values[k]);
+    }
+    if (options_.use_color) {
+      const Eigen::Vector3f difference = appearance_values_[j] - a.appearance;
+      for (int k = 0; k < 3; ++k) {
+        float value = difference[k];
+        const float period = appearance_.period[k];
+        if (period > 0.0F) value -= period * std::floor(value / period + 0.5F);
+        values[3 + k] = value * appearance_.scale[k];
+      }
+    }
+    float* shell = descriptor + shell_offset_[j];
+    for (int k = 0; k < histograms_; ++k) {
+      const float position = (values[k] - low_[k]) * scale_[k] - 0.5F;  // in bins, bin centres at integers
+      float* histogram = shell + k * kDescriptorBins;
+      if (options_.soft_binning) {  // shared linearly between the two nearest bins
+        const float clamped = std::clamp(position, 0.0F, static_cast<float>(bins_ - 1));
+        const int lower = std::min(static_cast<int>(clamped), bins_ - 2);
+        const float upper_share = clamped - static_cast<float>(lower);
+        histogram[lower] += weight * (1.0F - upper_share);
+        histogram[lower + 1] += weight * upper_share;
+      } else {  // the nearest bin
+        histogram[std::clamp(static_cast<int>(std::max(position, -0.5F) + 0.5F), 0, bins_ - 1)] += weight;
+      }
+    }
+  }
+
+  void Normalise(float* descriptor) const {
+    for (int h = 0; h < 6; ++h) {
+      float* histogram = descriptor + h * kDescriptorBins;
+      const float sum = std::accumulate(histogram, histogram + kDescriptorBins, 0.0F);
+      if (sum <= 0.0F) continue;
+      for (int bin = 0; bin < kDescriptorBins; ++bin) {
+        histogram[bin] = options_.hellinger ? std::sqrt(histogram[bin] / sum) : histogram[bin] / sum;
+      }
+    }
+  }
+
+  const AppearanceValues& appearance_;
+  const DescriptorOptions& options_;
+  const int bins_;        // per histogram and radial shell
+  const int histograms_;  // filled: 6, or the 3 geometric ones without colour
+  float low_[6] = {};     // value k of a pair lies in [low_k, 1]
+  float scale_[6] = {};
+  std::vector<Eigen::Vector3f> position_, orientation_, appearance_values_;  // of the gathered members
+  std::vector<float> weight_;
+  std::vector<int> shell_offset_;
+};
 
 }  // namespace
 
@@ -209,28 +253,27 @@ Descriptors ComputeDescriptors(const std::vector<Primitive>& input, const Descri
                      squared_radius, search);
 
   const AppearanceValues appearance = ComputeAppearance(primitives, options.appearance);
-  const Context context{primitives, appearance, options};
   // Row s describes source s (primitive s * step); the rows of isolated sources are dropped at the end.
   cv::Mat values(static_cast<int>(sources), kDescriptorSize, CV_32F);
-  auto describe = [&](size_t s) {
-    const size_t i = s * step;
-    const std::vector<size_t>& found = neighbour_lists[s];  // by distance, the source first
-    const size_t cap = options.max_neighbours > 0 ? static_cast<size_t>(options.max_neighbours) : found.size();
-    std::vector<int> neighbours;
-    std::vector<float> neighbour_distances;
-    for (size_t j = 0; j < std::min(cap, found.size()); ++j) {
-      // All, or evenly spread over the distance ranks, so that the context still spans the whole radius.
-      const size_t k = found.size() <= cap ? j : j * (found.size() - 1) / (cap - 1);
-      neighbours.push_back(static_cast<int>(found[k]));
-      neighbour_distances.push_back(std::sqrt(distances[s][k]));
-    }
-    DescribeContext(context, static_cast<int>(i), neighbours, neighbour_distances,
-                    values.ptr<float>(static_cast<int>(s)));
-  };
   std::atomic<size_t> next{0};
   auto work = [&] {
+    ContextHistograms histograms(appearance, options);  // per worker: reuses its buffers
+    std::vector<int> neighbours;
+    std::vector<float> neighbour_distances;
     for (size_t s = next++; s < sources; s = next++) {
-      if (neighbour_lists[s].size() >= 2) describe(s);  // isolated: no context
+      const std::vector<size_t>& found = neighbour_lists[s];  // by distance, the source first
+      if (found.size() < 2) continue;                         // isolated: no context
+      const size_t cap = options.max_neighbours > 0 ? static_cast<size_t>(options.max_neighbours) : found.size();
+      neighbours.clear();
+      neighbour_distances.clear();
+      for (size_t j = 0; j < std::min(cap, found.size()); ++j) {
+        // All, or evenly spread over the distance ranks, so that the context still spans the whole radius.
+        const size_t k = found.size() <= cap ? j : j * (found.size() - 1) / (cap - 1);
+        neighbours.push_back(static_cast<int>(found[k]));
+        neighbour_distances.push_back(std::sqrt(distances[s][k]));
+      }
+      histograms.Describe(primitives, static_cast<int>(s * step), neighbours, neighbour_distances,
+                          values.ptr<float>(static_cast<int>(s)));
     }
   };
   std::vector<std::thread> workers;
