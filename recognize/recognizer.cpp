@@ -38,6 +38,7 @@ struct Scene {
   std::unique_ptr<DescriptorMatcher> matcher;
   std::vector<Eigen::Vector3f> points;         // the depth points at dense_stride_px, for ICP
   std::vector<Eigen::Vector3f> ransac_points;  // primitive positions first, then the depth points at ransac_stride_px
+  std::unique_ptr<RadiusGrid> ransac_grid;     // over ransac_points, radius the inlier threshold: built once
   cv::Mat color;                               // the frame's colours, as verification compares them
   OrganizedScene organized;                    // the depth samples with normals, for projective ICP
   SceneVisibility visibility;
@@ -323,6 +324,8 @@ class Recognizer::Impl {
     scene->ransac_points = positions;
     const std::vector<Eigen::Vector3f> depth_points = DepthPoints(frame, options_.ransac_stride_px);
     scene->ransac_points.insert(scene->ransac_points.end(), depth_points.begin(), depth_points.end());
+    scene->ransac_grid =
+        std::make_unique<RadiusGrid>(scene->ransac_points, static_cast<float>(options_.ransac.inlier_threshold_m));
     result->timings_ms["extract"] = MillisecondsSince(stage);
 
     stage = Clock::now();
@@ -457,9 +460,9 @@ class Recognizer::Impl {
     ransac.sample_radius_m = options_.sample_radius_diameters * record.diameter_m;
     Hypothesis hypothesis;
     hypothesis.view = candidate->view;
-    hypothesis.ransac =
-        EstimatePoseRansac(PrimitivePositions(record.views[static_cast<size_t>(candidate->view)].primitives),
-                           scene.ransac_points, candidate->correspondences, ransac, &scene.visibility);
+    hypothesis.ransac = EstimatePoseRansac(
+        PrimitivePositions(record.views[static_cast<size_t>(candidate->view)].primitives), scene.ransac_points,
+        *scene.ransac_grid, candidate->correspondences, ransac, &scene.visibility);
     hypothesis.pose = hypothesis.ransac.scene_from_object;
     (*timings_ms)["ransac"] += MillisecondsSince(stage);
     if (!hypothesis.ransac.success) return;

@@ -41,6 +41,9 @@ class RadiusGrid {
   /// {-1, inf} when there is none.
   std::pair<int, float> NearestWithin(const Eigen::Vector3f& query) const;
 
+  float radius() const { return radius_; }
+  size_t size() const { return sorted_.size(); }
+
  private:
   float radius_ = 0.0F, cell_ = 1.0F;
   Eigen::Vector3f origin_ = Eigen::Vector3f::Zero();

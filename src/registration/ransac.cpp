@@ -69,14 +69,14 @@ double MeanPairDistance(const Eigen::Isometry3d& pose, const Inliers& inliers) {
 class Estimator {
  public:
   Estimator(const std::vector<Eigen::Vector3f>& object_points, const std::vector<Eigen::Vector3f>& scene_points,
-            const std::vector<Correspondence>& correspondences, const RansacOptions& options,
-            const SceneVisibility* visibility)
+            const RadiusGrid& scene_grid, const std::vector<Correspondence>& correspondences,
+            const RansacOptions& options, const SceneVisibility* visibility)
       : object_(object_points),
         scene_(scene_points),
         correspondences_(correspondences),
         options_(options),
         visibility_(visibility),
-        tree_(scene_points, static_cast<float>(options.inlier_threshold_m)),
+        tree_(scene_grid),
         order_(object_points.size()) {
     std::iota(order_.begin(), order_.end(), 0);
     std::mt19937_64 random(options.seed);
@@ -250,7 +250,7 @@ class Estimator {
   const std::vector<Correspondence>& correspondences_;
   const RansacOptions& options_;
   const SceneVisibility* visibility_;
-  const RadiusGrid tree_;
+  const RadiusGrid& tree_;
   std::vector<int> order_;                    // object points in a fixed random order, for the preverification
   std::vector<std::vector<int>> neighbours_;  // per correspondence, when sampling is local (sample_radius_m)
 };
@@ -307,6 +307,19 @@ RansacResult EstimatePoseRansac(const std::vector<Eigen::Vector3f>& object_point
                                 const std::vector<Correspondence>& correspondences, const RansacOptions& options,
                                 const SceneVisibility* visibility) {
   options.Check();
+  const RadiusGrid scene_grid(scene_points, static_cast<float>(options.inlier_threshold_m));
+  return EstimatePoseRansac(object_points, scene_points, scene_grid, correspondences, options, visibility);
+}
+
+RansacResult EstimatePoseRansac(const std::vector<Eigen::Vector3f>& object_points,
+                                const std::vector<Eigen::Vector3f>& scene_points, const RadiusGrid& scene_grid,
+                                const std::vector<Correspondence>& correspondences, const RansacOptions& options,
+                                const SceneVisibility* visibility) {
+  options.Check();
+  if (scene_grid.size() != scene_points.size() ||
+      scene_grid.radius() != static_cast<float>(options.inlier_threshold_m)) {
+    ThrowInputError("RANSAC", "scene_grid", "a grid over the scene points with the inlier threshold as radius");
+  }
   if (visibility != nullptr) visibility->Check();
   const auto start = std::chrono::steady_clock::now();
   RansacResult result;
@@ -319,7 +332,7 @@ RansacResult EstimatePoseRansac(const std::vector<Eigen::Vector3f>& object_point
       ThrowInputError("RANSAC", "correspondences", "indices inside the point sets");
     }
   }
-  const Estimator estimator(object_points, scene_points, correspondences, options, visibility);
+  const Estimator estimator(object_points, scene_points, scene_grid, correspondences, options, visibility);
   const int iterations = options.Iterations();
   const int blocks = (iterations + kBlockSize - 1) / kBlockSize;
   auto block_size = [&](int block) { return std::min(kBlockSize, iterations - block * kBlockSize); };

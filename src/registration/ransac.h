@@ -7,6 +7,7 @@
 #include <opencv2/core.hpp>
 
 #include "core/camera.h"
+#include "core/point_index.h"
 
 namespace ecv {
 
@@ -98,6 +99,14 @@ class PolygonEdgeCheck {
 /// `visibility` (optional) counts the required inliers against the visible object points only.
 RansacResult EstimatePoseRansac(const std::vector<Eigen::Vector3f>& object_points,
                                 const std::vector<Eigen::Vector3f>& scene_points,
+                                const std::vector<Correspondence>& correspondences, const RansacOptions& options = {},
+                                const SceneVisibility* visibility = nullptr);
+
+/// The same with `scene_points` already in `scene_grid`, a RadiusGrid over exactly those points with radius
+/// `options.inlier_threshold_m`: a recognizer that tries many views against one frame builds it once (over a
+/// frame's depth points its dense cells take megabytes to clear). Throws InputError when the grid does not fit.
+RansacResult EstimatePoseRansac(const std::vector<Eigen::Vector3f>& object_points,
+                                const std::vector<Eigen::Vector3f>& scene_points, const RadiusGrid& scene_grid,
                                 const std::vector<Correspondence>& correspondences, const RansacOptions& options = {},
                                 const SceneVisibility* visibility = nullptr);
 

@@ -67,5 +67,38 @@ TEST(RadiusGrid, NearestWithinAgreesWithBruteForce) {
   for (size_t i = 0; i < spread.size(); i += 37) EXPECT_EQ(coarse.NearestWithin(spread[i]).first, static_cast<int>(i));
 }
 
+// Depth-like data: a tilted, gently curved sheet sampled every 4 mm, queried just off it (within and beyond the
+// radius), where a query's nearest point often lies in a neighbouring cell of the grid.
+TEST(RadiusGrid, NearestWithinOnASurfaceAgreesWithBruteForce) {
+  std::vector<Eigen::Vector3f> sheet;
+  for (int row = 0; row < 60; ++row) {
+    for (int column = 0; column < 60; ++column) {
+      const float x = -0.12F + 0.004F * static_cast<float>(column);
+      const float y = -0.12F + 0.004F * static_cast<float>(row);
+      sheet.emplace_back(x, y, 0.8F + 0.3F * x + 0.5F * x * y);
+    }
+  }
+  std::mt19937 random(7);
+  std::uniform_real_distribution<float> along(-0.13F, 0.13F), off(-0.015F, 0.015F);
+  const RadiusGrid grid(sheet, 0.01F);
+  int hits = 0, misses = 0;
+  for (int i = 0; i < 5000; ++i) {
+    const float x = along(random), y = along(random);
+    const Eigen::Vector3f query(x, y, 0.8F + 0.3F * x + 0.5F * x * y + off(random));
+    const auto [expected, expected_squared] = BruteNearest(sheet, query);
+    const auto [found, squared] = grid.NearestWithin(query);
+    if (expected_squared <= 0.01F * 0.01F) {
+      ++hits;
+      EXPECT_EQ(found, expected) << "query " << query.transpose();
+      EXPECT_FLOAT_EQ(squared, expected_squared);
+    } else {
+      ++misses;
+      EXPECT_EQ(found, -1) << "query " << query.transpose();
+    }
+  }
+  EXPECT_GT(hits, 1000);
+  EXPECT_GT(misses, 100);
+}
+
 }  // namespace
 }  // namespace ecv

@@ -1,6 +1,7 @@
 // The paper's prerejective RANSAC and standard RANSAC on constructed correspondences with a known pose.
 
 #include <random>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -145,6 +146,34 @@ TEST(Ransac, SameSeedSameResult) {
   EXPECT_EQ(first.scene_from_object.matrix(), second.scene_from_object.matrix());
   EXPECT_EQ(first.rejected_by_polygon, second.rejected_by_polygon);
   EXPECT_EQ(first.fit_error_m, second.fit_error_m);
+}
+
+// A grid built once for many runs (the recognizer's, one per frame) gives what each run's own grid gives; a grid
+// over other points, or of another radius, is refused by name.
+TEST(Ransac, ASharedSceneGridGivesTheSameResultAndAWrongOneIsRefused) {
+  const Problem problem = MakeProblem(300, 60, 400, 0.001, 4);
+  RansacOptions options;
+  options.max_iterations = 3000;
+  options.expected_inlier_ratio = 0.15;
+  const RadiusGrid grid(problem.scene, static_cast<float>(options.inlier_threshold_m));
+  const RansacResult own = EstimatePoseRansac(problem.object, problem.scene, problem.correspondences, options);
+  const RansacResult shared = EstimatePoseRansac(problem.object, problem.scene, grid, problem.correspondences, options);
+  ASSERT_TRUE(own.success);
+  EXPECT_EQ(own.scene_from_object.matrix(), shared.scene_from_object.matrix());
+  EXPECT_EQ(own.fit_error_m, shared.fit_error_m);
+  EXPECT_EQ(own.inlier_fraction, shared.inlier_fraction);
+
+  const RadiusGrid wider(problem.scene, 2.0F * static_cast<float>(options.inlier_threshold_m));
+  const std::vector<Eigen::Vector3f> fewer(problem.scene.begin(), problem.scene.end() - 1);
+  const RadiusGrid other(fewer, static_cast<float>(options.inlier_threshold_m));
+  for (const RadiusGrid* wrong : {&wider, &other}) {
+    try {
+      EstimatePoseRansac(problem.object, problem.scene, *wrong, problem.correspondences, options);
+      ADD_FAILURE() << "a grid that does not fit was accepted";
+    } catch (const InputError& error) {
+      EXPECT_NE(std::string(error.what()).find("scene_grid"), std::string::npos) << error.what();
+    }
+  }
 }
 
 TEST(Ransac, TwoThreadsGiveTheSameResultAsOne) {
