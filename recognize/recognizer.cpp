@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <exception>
 #include <functional>
 #include <mutex>
@@ -48,27 +49,33 @@ struct Scene {
 Descriptors CopyRows(const Descriptors& descriptors, const std::vector<int>& rows) {
   Descriptors copy;
   copy.values.create(static_cast<int>(rows.size()), descriptors.values.cols, descriptors.values.type());
+  const size_t row_bytes = static_cast<size_t>(descriptors.values.cols) * descriptors.values.elemSize();
+  copy.primitive.reserve(rows.size());
   for (size_t i = 0; i < rows.size(); ++i) {
-    descriptors.values.row(rows[i]).copyTo(copy.values.row(static_cast<int>(i)));
+    std::memcpy(copy.values.ptr(static_cast<int>(i)), descriptors.values.ptr(rows[i]), row_bytes);
     copy.primitive.push_back(descriptors.primitive[static_cast<size_t>(rows[i])]);
   }
   return copy;
 }
 
-// A seeded random subset of `count` rows of `descriptors` (all of them when there are no more) and the other
-// rows, each in row order.
-std::pair<Descriptors, Descriptors> SplitRows(const Descriptors& descriptors, size_t count, uint64_t seed) {
-  const size_t rows = static_cast<size_t>(descriptors.values.rows);
-  if (rows <= count) return {descriptors, CopyRows(descriptors, {})};
-  std::vector<int> order(rows);
-  std::iota(order.begin(), order.end(), 0);
+// Row numbers of a view's descriptors: a seeded random subset of `count` of its `rows` (all of them when there
+// are no more), for the ranking, and the rest; each in row order.
+struct RowSplit {
+  std::vector<int> ranking, rest;
+};
+
+RowSplit SplitRows(size_t rows, size_t count, uint64_t seed) {
+  RowSplit split;
+  split.ranking.resize(rows);
+  std::iota(split.ranking.begin(), split.ranking.end(), 0);
+  if (rows <= count) return split;
   std::mt19937_64 random(seed);
-  std::shuffle(order.begin(), order.end(), random);
-  std::vector<int> rest(order.begin() + static_cast<std::ptrdiff_t>(count), order.end());
-  order.resize(count);
-  std::sort(order.begin(), order.end());
-  std::sort(rest.begin(), rest.end());
-  return {CopyRows(descriptors, order), CopyRows(descriptors, rest)};
+  std::shuffle(split.ranking.begin(), split.ranking.end(), random);
+  split.rest.assign(split.ranking.begin() + static_cast<std::ptrdiff_t>(count), split.ranking.end());
+  split.ranking.resize(count);
+  std::sort(split.ranking.begin(), split.ranking.end());
+  std::sort(split.rest.begin(), split.rest.end());
+  return split;
 }
 
 // A verified pose: the detection, the pixels (at dense_stride_px) where its rendered surface lies on the
@@ -399,7 +406,8 @@ class Recognizer::Impl {
       ViewCandidate candidate;
       candidate.view = static_cast<int>(v);
       // Scored on a seeded subset of the view's descriptors, for speed.
-      candidate.correspondences = Correspondences(view, RankingRows(model, v).first, scene);
+      candidate.correspondences =
+          Correspondences(view, CopyRows(view.descriptors, RankingRows(model, v).ranking), scene);
       ConsistencyOptions consistency = options_.consistency;
       consistency.max_distance_m = record.diameter_m;
       candidate.score = ConsistentSetSize(view.primitives, scene.primitives, candidate.correspondences, consistency);
@@ -413,9 +421,9 @@ class Recognizer::Impl {
     return views;
   }
 
-  // A view's ranking subset of descriptors (consistency_max_correspondences of them) and the other rows.
-  std::pair<Descriptors, Descriptors> RankingRows(size_t model, size_t view) const {
-    return SplitRows(records_[model].views[view].descriptors,
+  // A view's ranking subset of descriptor rows (consistency_max_correspondences of them) and the other rows.
+  RowSplit RankingRows(size_t model, size_t view) const {
+    return SplitRows(static_cast<size_t>(records_[model].views[view].descriptors.values.rows),
                      static_cast<size_t>(options_.consistency_max_correspondences), options_.ransac.seed + view);
   }
 
@@ -427,7 +435,8 @@ class Recognizer::Impl {
     if (candidate->matched) return;
     const auto view = static_cast<size_t>(candidate->view);
     const ModelView& model_view = records_[model].views[view];
-    std::vector<Correspondence> found = Correspondences(model_view, RankingRows(model, view).second, scene);
+    std::vector<Correspondence> found =
+        Correspondences(model_view, CopyRows(model_view.descriptors, RankingRows(model, view).rest), scene);
     found.insert(found.end(), candidate->correspondences.begin(), candidate->correspondences.end());
     std::sort(found.begin(), found.end(), [&](const Correspondence& a, const Correspondence& b) {
       return MatchOrderLess(model_view.primitives, options_.match.structure_specific, a.object, b.object);

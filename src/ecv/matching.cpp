@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <mutex>
 #include <string>
 
@@ -32,8 +33,9 @@ void SelectRows(const Descriptors& descriptors, Keep keep, cv::Mat* values, std:
   }
   values->create(static_cast<int>(rows.size()), descriptors.values.cols, CV_32F);
   primitive->clear();
+  const size_t row_bytes = static_cast<size_t>(descriptors.values.cols) * sizeof(float);
   for (size_t i = 0; i < rows.size(); ++i) {
-    descriptors.values.row(rows[i]).copyTo(values->row(static_cast<int>(i)));
+    std::memcpy(values->ptr<float>(static_cast<int>(i)), descriptors.values.ptr<float>(rows[i]), row_bytes);
     primitive->push_back(descriptors.primitive[static_cast<size_t>(rows[i])]);
   }
 }
