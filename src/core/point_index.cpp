@@ -78,40 +78,24 @@ RadiusGrid::RadiusGrid(const std::vector<Eigen::Vector3f>& points, float radius)
 std::pair<int, float> RadiusGrid::NearestWithin(const Eigen::Vector3f& query) const {
   std::pair<int, float> best{-1, std::numeric_limits<float>::infinity()};
   if (sorted_.empty()) return best;
-  const Eigen::Array3f local = (query - origin_).array() / cell_;
-  const float reach = radius_ / cell_;
+  const Eigen::Vector3f low = (query.array() - radius_ - origin_.array()) / cell_;
+  const Eigen::Vector3f high = (query.array() + radius_ - origin_.array()) / cell_;
   // Clamped in float first, so that far-away queries cannot overflow the integer cast.
   const Eigen::Array3f top = size_.array().cast<float>() - 1.0F;
-  const Eigen::Array3i first = (local - reach).floor().max(0.0F).min(top + 1.0F).cast<int>();
-  const Eigen::Array3i last = (local + reach).floor().min(top).max(-1.0F).cast<int>();
+  const Eigen::Vector3i first = low.array().floor().max(0.0F).min(top + 1.0F).cast<int>();
+  const Eigen::Vector3i last = high.array().floor().min(top).max(-1.0F).cast<int>();
   float best_squared = radius_ * radius_;
-  auto scan = [&](const Eigen::Array3i& c) {
-    const size_t cell = static_cast<size_t>((c.z() * size_.y() + c.y()) * size_.x() + c.x());
-    for (uint32_t i = cell_start_[cell]; i < cell_start_[cell + 1]; ++i) {
-      const float squared = (sorted_[i] - query).squaredNorm();
-      if (squared <= best_squared) {
-        best_squared = squared;
-        best = {sorted_index_[i], squared};
-      }
-    }
-  };
-  // The query's own cell first: on a surface its nearest point is usually there, and then rules out the
-  // other cells, which are visited only when their box comes nearer than the best point so far. The box
-  // distance is taken a micrometre short, so that rounding never rules out a cell that holds the nearest.
-  const Eigen::Array3i own = local.floor().max(-1.0F).min(top + 1.0F).cast<int>();
-  const bool own_inside = (own >= first).all() && (own <= last).all();
-  if (own_inside) scan(own);
-  constexpr float kSlack = 1e-6F;
   for (int z = first.z(); z <= last.z(); ++z) {
     for (int y = first.y(); y <= last.y(); ++y) {
       for (int x = first.x(); x <= last.x(); ++x) {
-        const Eigen::Array3i c(x, y, z);
-        if (own_inside && (c == own).all()) continue;
-        const Eigen::Array3f low_corner = c.cast<float>();
-        const Eigen::Array3f outside =
-            ((low_corner - local).max(local - (low_corner + 1.0F)).max(0.0F) * cell_ - kSlack).max(0.0F);
-        if (outside.matrix().squaredNorm() > best_squared) continue;
-        scan(c);
+        const size_t c = static_cast<size_t>((z * size_.y() + y) * size_.x() + x);
+        for (uint32_t i = cell_start_[c]; i < cell_start_[c + 1]; ++i) {
+          const float squared = (sorted_[i] - query).squaredNorm();
+          if (squared <= best_squared) {
+            best_squared = squared;
+            best = {sorted_index_[i], squared};
+          }
+        }
       }
     }
   }
