@@ -3,7 +3,7 @@
 //
 //   ecv_bench [--runs N] [--results FILE]
 
-#include <cstring>
+#include <cstdio>
 #include <iostream>
 #include <memory>
 #include <stdexcept>

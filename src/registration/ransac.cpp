@@ -306,7 +306,6 @@ RansacResult EstimatePoseRansac(const std::vector<Eigen::Vector3f>& object_point
                                 const std::vector<Eigen::Vector3f>& scene_points,
                                 const std::vector<Correspondence>& correspondences, const RansacOptions& options,
                                 const SceneVisibility* visibility) {
-  options.Check();
   const RadiusGrid scene_grid(scene_points, static_cast<float>(options.inlier_threshold_m));
   return EstimatePoseRansac(object_points, scene_points, scene_grid, correspondences, options, visibility);
 }

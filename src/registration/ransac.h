@@ -103,8 +103,8 @@ RansacResult EstimatePoseRansac(const std::vector<Eigen::Vector3f>& object_point
                                 const SceneVisibility* visibility = nullptr);
 
 /// The same with `scene_points` already in `scene_grid`, a RadiusGrid over exactly those points with radius
-/// `options.inlier_threshold_m`: a recognizer that tries many views against one frame builds it once (over a
-/// frame's depth points its dense cells take megabytes to clear). Throws InputError when the grid does not fit.
+/// `options.inlier_threshold_m`: a recognizer that tries many views against one frame builds it once (about
+/// 0.3 ms per build over a YCB-Video frame's points). Throws InputError when the grid does not fit.
 RansacResult EstimatePoseRansac(const std::vector<Eigen::Vector3f>& object_points,
                                 const std::vector<Eigen::Vector3f>& scene_points, const RadiusGrid& scene_grid,
                                 const std::vector<Correspondence>& correspondences, const RansacOptions& options = {},
