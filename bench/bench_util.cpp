@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <ctime>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <numeric>
@@ -51,6 +52,21 @@ double Median(std::vector<double> values) {
 double Mean(const std::vector<double>& values) {
   if (values.empty()) return 0.0;
   return std::accumulate(values.begin(), values.end(), 0.0) / static_cast<double>(values.size());
+}
+
+std::vector<std::string> YcbvFramePrefixes(const std::string& data_dir) {
+  std::vector<std::string> prefixes;
+  const std::string suffix = "-color.png";
+  for (const auto& video : std::filesystem::directory_iterator(data_dir + "/ycbv_subset/Example-Scenes")) {
+    for (const auto& file : std::filesystem::directory_iterator(video.path())) {
+      const std::string name = file.path().string();
+      if (name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0) {
+        prefixes.push_back(name.substr(0, name.size() - suffix.size()));
+      }
+    }
+  }
+  std::sort(prefixes.begin(), prefixes.end());
+  return prefixes;
 }
 
 void Report(const std::string& results_path, const std::string& title, const std::string& command,

@@ -26,6 +26,10 @@ double Median(std::vector<double> values);
 /// Mean of `values`; 0 for none.
 double Mean(const std::vector<double>& values);
 
+/// The frame prefixes ("DIR/0001/000001") of YCB-Video's subset under `data_dir` (ycbv_subset/Example-Scenes),
+/// sorted: the 30 frames of videos 0000-0002.
+std::vector<std::string> YcbvFramePrefixes(const std::string& data_dir);
+
 /// Prints `markdown` and appends it to `results_path` under a heading with `title`, the date, the machine
 /// and the command.
 void Report(const std::string& results_path, const std::string& title, const std::string& command,

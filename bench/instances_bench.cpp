@@ -11,7 +11,6 @@
 
 #include <algorithm>
 #include <cstring>
-#include <filesystem>
 #include <iostream>
 #include <sstream>
 
@@ -100,25 +99,10 @@ std::string TwoBottlesTable(const ModelLibrary& library, int seeds, const std::s
   return table.str();
 }
 
-std::vector<std::string> YcbvPrefixes() {
-  std::vector<std::string> prefixes;
-  for (const auto& video :
-       std::filesystem::directory_iterator(std::string(ECV_DATA_DIR) + "/ycbv_subset/Example-Scenes")) {
-    for (const auto& file : std::filesystem::directory_iterator(video.path())) {
-      const std::string name = file.path().string(), suffix = "-color.png";
-      if (name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0) {
-        prefixes.push_back(name.substr(0, name.size() - suffix.size()));
-      }
-    }
-  }
-  std::sort(prefixes.begin(), prefixes.end());
-  return prefixes;
-}
-
 std::string SingleInstanceTable(const ModelLibrary& library) {
   const std::vector<EvalModel> models = EvalModels(library);
   std::vector<LoadedFrame> frames;
-  for (const std::string& prefix : YcbvPrefixes()) frames.push_back(LoadYcbvFrame(prefix));
+  for (const std::string& prefix : YcbvFramePrefixes(ECV_DATA_DIR)) frames.push_back(LoadYcbvFrame(prefix));
   std::ostringstream table;
   table << "\nThe " << frames.size()
         << " YCB-Video frames (one instance of each object), 7-model library, seed 1, one thread:\n\n"

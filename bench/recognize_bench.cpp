@@ -34,17 +34,7 @@ struct NamedFrame {
 };
 
 std::vector<NamedFrame> YcbvFrames(const std::string& data, int limit, int step) {
-  std::vector<std::string> prefixes;
-  for (const auto& video : std::filesystem::directory_iterator(data + "/ycbv_subset/Example-Scenes")) {
-    for (const auto& file : std::filesystem::directory_iterator(video.path())) {
-      const std::string name = file.path().string();
-      const std::string suffix = "-color.png";
-      if (name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0) {
-        prefixes.push_back(name.substr(0, name.size() - suffix.size()));
-      }
-    }
-  }
-  std::sort(prefixes.begin(), prefixes.end());
+  std::vector<std::string> prefixes = YcbvFramePrefixes(data);
   std::vector<std::string> kept;
   for (size_t i = 0; i < prefixes.size(); i += static_cast<size_t>(std::max(step, 1))) kept.push_back(prefixes[i]);
   prefixes = kept;

@@ -224,6 +224,30 @@ class Recognizer::Impl {
     }
   }
 
+  // Every model's views, best ranked first, with their ranking correspondences (Recognizer::RankViews).
+  std::map<std::string, std::vector<RankedView>> RankViews(const RgbdFrame& frame) {
+    frame.Check();
+    Scene scene = PrepareScene(frame);
+    RecognitionResult unused;
+    DescribeScene(&scene, &unused);
+    std::vector<std::vector<ViewCandidate>> scored(records_.size());
+    ParallelFor(records_.size(), options_.ransac.threads, [&](size_t m) { scored[m] = ScoreViews(m, scene); });
+    std::map<std::string, std::vector<RankedView>> ranked;
+    for (size_t m = 0; m < records_.size(); ++m) {
+      std::vector<RankedView>& views = ranked[records_[m].name];
+      for (const ViewCandidate& candidate : scored[m]) {
+        RankedView view{candidate.view, candidate.score, {}};
+        const std::vector<Primitive>& primitives = records_[m].views[static_cast<size_t>(candidate.view)].primitives;
+        for (const Correspondence& c : candidate.correspondences) {
+          view.correspondences.emplace_back(primitives[static_cast<size_t>(c.object)],
+                                            scene.primitives[static_cast<size_t>(c.scene)]);
+        }
+        views.push_back(std::move(view));
+      }
+    }
+    return ranked;
+  }
+
   RecognitionResult Recognize(const RgbdFrame& frame, const std::vector<Detection>& priors) {
     frame.Check();
     const Clock::time_point start = Clock::now();
@@ -397,6 +421,15 @@ class Recognizer::Impl {
 
   // The model's views, best ranked first; the best views_per_model with all their correspondences (Match).
   std::vector<ViewCandidate> RankViews(size_t model, const Scene& scene) const {
+    std::vector<ViewCandidate> views = ScoreViews(model, scene);
+    for (size_t i = 0; i < std::min(views.size(), static_cast<size_t>(options_.views_per_model)); ++i) {
+      Match(model, scene, &views[i]);
+    }
+    return views;
+  }
+
+  // The model's views, best ranked first, each with the correspondences of its ranking subset of descriptors.
+  std::vector<ViewCandidate> ScoreViews(size_t model, const Scene& scene) const {
     std::vector<ViewCandidate> views;
     if (!scene.matcher) return views;
     const ModelRecord& record = records_[model];
@@ -415,9 +448,6 @@ class Recognizer::Impl {
     }
     std::stable_sort(views.begin(), views.end(),
                      [](const ViewCandidate& a, const ViewCandidate& b) { return a.score > b.score; });
-    for (size_t i = 0; i < std::min(views.size(), static_cast<size_t>(options_.views_per_model)); ++i) {
-      Match(model, scene, &views[i]);
-    }
     return views;
   }
 
@@ -707,6 +737,10 @@ RecognitionResult Recognizer::Recognize(const RgbdFrame& frame) {
 
 RecognitionResult Recognizer::Recognize(const RgbdFrame& frame, const std::vector<Detection>& priors) {
   return impl_->Recognize(frame, priors);
+}
+
+std::map<std::string, std::vector<RankedView>> Recognizer::RankViews(const RgbdFrame& frame) {
+  return impl_->RankViews(frame);
 }
 
 cv::Mat Recognizer::DrawDetections(const RgbdFrame& frame, const std::vector<Detection>& detections) {

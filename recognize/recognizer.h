@@ -3,6 +3,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -11,6 +12,7 @@
 
 #include "core/frame.h"
 #include "ecv/matching.h"
+#include "ecv/primitives.h"
 #include "modeldb/model_library.h"
 #include "recognize/scoring.h"
 #include "registration/icp.h"
@@ -159,6 +161,15 @@ struct RecognitionResult {
   int scene_primitives = 0;
 };
 
+/// One library view as view ranking saw it in a frame.
+struct RankedView {
+  int view = -1;  ///< index among the model's views
+  int score = 0;  ///< ConsistentSetSize of its ranking correspondences
+  /// Its ranking correspondences: a view primitive (object frame) and its nearest scene primitive by descriptor
+  /// (camera frame).
+  std::vector<std::pair<Primitive, Primitive>> correspondences;
+};
+
 /// The detections JSON of DESIGN.md "Interfaces": {"detections": [{"model", "score", "camera_from_object",
 /// "inlier_fraction", "fit_error", "view", ...}], "timings_ms": {stage: ms}}.
 nlohmann::json RecognitionToJson(const RecognitionResult& result);
@@ -182,6 +193,10 @@ class Recognizer {
   /// first tried at its pose, refined by ICP and verified as any detection; when it passes, its model skips
   /// view ranking and RANSAC in this frame. Models without a prior, or whose prior fails, are recognised.
   RecognitionResult Recognize(const RgbdFrame& frame, const std::vector<Detection>& priors);
+
+  /// View ranking alone, for studying it: every model's views as Recognize ranks them in `frame`, best first
+  /// (RANSAC tries the first views_per_model of them).
+  std::map<std::string, std::vector<RankedView>> RankViews(const RgbdFrame& frame);
 
   /// `frame`'s colour image with each detected model rendered at its pose in red, outlined, with its name.
   cv::Mat DrawDetections(const RgbdFrame& frame, const std::vector<Detection>& detections);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <map>
 
 #include <gtest/gtest.h>
 
@@ -72,6 +73,33 @@ TEST_F(RecognizeEndToEnd, FindsTheObjectsOfTheDemoFrameWithinTenthOfTheirDiamete
   const test::CommandResult eval = test::RunCli("eval --detections " + json + " --db " + library_ + " " + Frame());
   ASSERT_EQ(eval.exit_code, 0) << eval.output;
   EXPECT_NE(eval.output.find("| 003_cracker_box | yes |"), std::string::npos) << eval.output;
+}
+
+// View ranking alone (what ranking_bench studies): every view of every model, best first, and the views ranked
+// first for the cracker box hold right correspondences (its view picked first had 10 of 10 good in ranking_bench).
+TEST_F(RecognizeEndToEnd, RankViewsListsEveryViewBestFirstAndRanksARightViewFirstForTheCrackerBox) {
+  const LoadedFrame frame = LoadYcbvFrame(Frame());
+  const ModelLibrary library = ModelLibrary::Load(library_);
+  Recognizer recognizer(library);
+  const std::map<std::string, std::vector<RankedView>> ranked = recognizer.RankViews(frame.rgbd);
+  ASSERT_EQ(ranked.size(), library.models().size());
+  for (const LibraryModel& model : library.models()) {
+    const std::vector<RankedView>& views = ranked.at(model.record.name);
+    ASSERT_EQ(views.size(), model.record.views.size()) << model.record.name;
+    for (size_t i = 1; i < views.size(); ++i) EXPECT_GE(views[i - 1].score, views[i].score) << model.record.name;
+    for (const RankedView& view : views) {
+      EXPECT_LE(view.correspondences.size(), static_cast<size_t>(RecognizerOptions().consistency_max_correspondences));
+    }
+  }
+  const auto truth = std::find_if(frame.ground_truth.begin(), frame.ground_truth.end(),
+                                  [](const GroundTruth& t) { return t.object_name == "003_cracker_box"; });
+  ASSERT_NE(truth, frame.ground_truth.end());
+  const Eigen::Isometry3f camera_from_object = truth->camera_from_object.cast<float>();
+  const RankedView& first = ranked.at("003_cracker_box").front();
+  const auto right = std::count_if(first.correspondences.begin(), first.correspondences.end(), [&](const auto& pair) {
+    return (camera_from_object * pair.first.position - pair.second.position).norm() < 0.015F;
+  });
+  EXPECT_GE(right, 6) << "view " << first.view << ", score " << first.score;
 }
 
 TEST_F(RecognizeEndToEnd, SameSeedSameDetections) {
