@@ -51,9 +51,10 @@ struct PlanePatchOptions {
 bool PatchOfLargerPlane(const std::vector<Eigen::Vector3f>& surface, const std::vector<Eigen::Vector3f>& ring,
                         const PlanePatchOptions& options = {});
 
-/// Normalised cross-correlation of (model, scene) colour pairs, per channel, averaged and clipped to [0, 1];
-/// 0 for fewer than 10 pairs. High when the model's texture lies where the scene shows it, whatever the
-/// gain and offset of the light.
+/// Normalised cross-correlation of (model, scene) colour pairs in [0, 1]; 0 for fewer than 10 pairs. High when
+/// the model's texture lies where the scene shows it, whatever the brightness and white balance of the light:
+/// the smaller of the correlation per channel (averaged; each channel's own gain and offset) and the
+/// correlation over all channels at once (one gain and offset, so a pattern in another hue scores low).
 double ColorCorrelation(const std::vector<std::pair<Eigen::Vector3f, Eigen::Vector3f>>& colors);
 
 }  // namespace ecv
