@@ -151,8 +151,9 @@ int Main(int argc, char** argv) {
   std::vector<double> ms;
   const std::string table = Run(library, options, &ms);
   std::ostringstream markdown;
-  markdown << "Library `" << db << "` (" << library.models().size() << " models), the 30 YCB-Video frames, seed "
-           << options.ransac.seed << " (it picks each view's " << options.consistency_max_correspondences
+  markdown << "Library `" << db << "` (" << library.models().size() << " models), the " << ms.size()
+           << " YCB-Video frames, seed " << options.ransac.seed << " (it picks each view's "
+           << options.consistency_max_correspondences
            << " ranking descriptors), one thread. Right = the ground truth puts the view primitive within "
            << kRightM * 100.0F << " cm of its scene primitive; good view = " << kGoodView
            << " or more right. Score = the ranking's consistent-set size. Median ms per frame for describing the "
