@@ -141,21 +141,12 @@ std::vector<Eigen::Vector3f> Positions(const std::vector<Primitive>& primitives)
 
 using Method = std::function<PairScore(const ViewPair&, const PairPrimitives&)>;
 
-// Issue 5's descriptor variant: source pairs {s, n} in four radial shells over 4.5 cm (bench/RESULTS.md).
-DescriptorOptions SourceShellOptions() {
-  DescriptorOptions options;
-  options.pairs = DescriptorPairs::kSource;
-  options.shells = 4;
-  options.radius_m = 0.045;
-  return options;
-}
-
 std::vector<std::pair<std::string, Method>> Methods() {
   std::vector<std::pair<std::string, Method>> methods;
   methods.emplace_back("ECV context",
                        [](const ViewPair& pair, const PairPrimitives& p) { return ScoreEcv(pair, p, {}, {}); });
   methods.emplace_back("ECV source pairs, 4 shells, r 4.5 cm", [](const ViewPair& pair, const PairPrimitives& p) {
-    return ScoreEcv(pair, p, SourceShellOptions(), {});
+    return ScoreEcv(pair, p, DescriptorOptions::SourceShells(), {});
   });
   auto add_pcl = [&](PclDescriptor descriptor, double radius_m, const std::string& suffix) {
     methods.emplace_back(

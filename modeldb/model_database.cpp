@@ -160,7 +160,8 @@ std::optional<FeatureSettings> ModelDatabase::feature_settings() const {
   SqlStatement count = connection.Prepare("SELECT count(*) FROM models");
   count.Step();
   if (count.Int(0) == 0) return std::nullopt;
-  return FeatureSettingsFromJson(MetaValue(connection, "features"), connection.path() + ": meta features");
+  return FeatureSettingsFromJson(MetaValue(connection, "features"), connection.path() + ": meta features",
+                                 StoredFeatureDefaults());
 }
 
 AddModelResult ModelDatabase::AddModel(const ModelRecord& record, const InsertProgress& progress) {

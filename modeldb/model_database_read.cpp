@@ -142,8 +142,8 @@ std::vector<StoredModel> ModelDatabase::LoadModels(const std::vector<std::string
   }
   std::vector<StoredModel> models;
   if (wanted.empty()) return models;
-  const FeatureSettings features =
-      FeatureSettingsFromJson(MetaValue(connection, "features"), connection.path() + ": meta features");
+  const FeatureSettings features = FeatureSettingsFromJson(
+      MetaValue(connection, "features"), connection.path() + ": meta features", StoredFeatureDefaults());
   for (const std::string& name : wanted) {
     StoredModel model{ReadModel(connection, name, features), std::nullopt};
     model.color_matrix = ReadColorMatrix(connection, RequireModelId(connection, name));
@@ -176,7 +176,7 @@ VerifyReport ModelDatabase::Verify(bool check_descriptors) const {
   report.descriptors = counts.Int(3);
   if (report.models > 0) {
     try {
-      FeatureSettingsFromJson(MetaValue(connection, "features"), "meta features");
+      FeatureSettingsFromJson(MetaValue(connection, "features"), "meta features", StoredFeatureDefaults());
     } catch (const InputError& error) {
       report.problems.push_back(error.what());
     }

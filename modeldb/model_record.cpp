@@ -70,10 +70,15 @@ std::string FeatureSettingsToJson(const FeatureSettings& settings) {
   return ToJson(settings).dump();
 }
 
-FeatureSettings FeatureSettingsFromJson(const std::string& text, const std::string& source) {
+FeatureSettings StoredFeatureDefaults() {
+  return {EcvOptions{}, DescriptorOptions{}};
+}
+
+FeatureSettings FeatureSettingsFromJson(const std::string& text, const std::string& source,
+                                        const FeatureSettings& missing) {
   const nlohmann::json json = nlohmann::json::parse(text, nullptr, false);
   if (!json.is_object()) ThrowInputError(source, "feature settings", "a JSON object", text.substr(0, 80));
-  FeatureSettings settings;
+  FeatureSettings settings = missing;
   const nlohmann::ordered_json known = ToJson(settings);
   RejectUnknown(json, known, source);
   const nlohmann::json ecv = json.value("ecv", nlohmann::json::object());

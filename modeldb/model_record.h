@@ -16,14 +16,21 @@ namespace ecv {
 /// recognition extracts the scene's features with them too.
 struct FeatureSettings {
   EcvOptions ecv;
-  DescriptorOptions descriptor;
+  DescriptorOptions descriptor = DescriptorOptions::SourceShells();
 };
+
+/// What a stored field that is missing meant when it was written: libraries from before the descriptor's
+/// `pairs` and `shells` fields existed were built with all pairs in one shell (DescriptorOptions' field defaults).
+FeatureSettings StoredFeatureDefaults();
 
 /// The settings as canonical JSON text (every field, fixed order), as stored in the library.
 std::string FeatureSettingsToJson(const FeatureSettings& settings);
 
-/// Settings from JSON text; fields that are missing keep their defaults. Throws InputError naming `source`.
-FeatureSettings FeatureSettingsFromJson(const std::string& text, const std::string& source);
+/// Settings from JSON text; fields that are missing take their values from `missing` (a user's partial
+/// settings: today's defaults; a library's stored ones: StoredFeatureDefaults()). Throws InputError naming
+/// `source`.
+FeatureSettings FeatureSettingsFromJson(const std::string& text, const std::string& source,
+                                        const FeatureSettings& missing = {});
 
 /// One rendered view of a library model.
 struct ModelView {

@@ -194,6 +194,8 @@ void RecognizerOptions::Check() const {
   require(max_instances >= 1, "max_instances", "at least 1");
   require(later_instance_views >= 0, "later_instance_views", ">= 0 (0: views_per_model)");
   require(color_blur_px >= 0.0, "color_blur_px", ">= 0 pixels");
+  require(residual_free_m >= 0.0, "residual_free_m", ">= 0 m");
+  require(residual_falloff_m >= 0.0, "residual_falloff_m", ">= 0 m (0: no residual factor)");
   require(min_score >= 0.0 && min_score <= 1.0, "min_score", "in [0, 1]");
   require(min_track_start_score >= 0.0 && min_track_start_score <= 1.0, "min_track_start_score", "in [0, 1]");
   require(min_visible_fraction >= 0.0 && min_visible_fraction <= 1.0, "min_visible_fraction", "in [0, 1]");
@@ -585,6 +587,7 @@ class Recognizer::Impl {
       to_scene = library_model.color_matrix->model_to_scene.cast<float>();
     }
     int rendered_pixels = 0, visible = 0;
+    double residual_sum = 0.0;
     Verified verified;
     std::vector<std::pair<Eigen::Vector3f, Eigen::Vector3f>> colors;  // (model through A, scene) on the surface
     const float tolerance = static_cast<float>(options_.depth_tolerance_m);
@@ -598,6 +601,7 @@ class Recognizer::Impl {
         if (scene_z <= 0.0F || scene_z < model_z - tolerance) continue;  // no measurement, or hidden
         ++visible;
         if (std::abs(scene_z - model_z) > tolerance) continue;
+        residual_sum += std::abs(scene_z - model_z);
         verified.surface.emplace_back(scene_u, scene_v);
         const cv::Vec3b& m = model_color.at<cv::Vec3b>(v, u);
         const cv::Vec3b& s = scene.color.at<cv::Vec3b>(scene_v, scene_u);
@@ -616,12 +620,20 @@ class Recognizer::Impl {
     detection.view = hypothesis.view;
     detection.visible_fraction = rendered_pixels > 0 ? static_cast<double>(visible) / rendered_pixels : 0.0;
     detection.depth_agreement = visible > 0 ? static_cast<double>(on_surface) / visible : 0.0;
-    detection.score = detection.depth_agreement * detection.color_agreement;
+    detection.surface_error_m = on_surface > 0 ? residual_sum / on_surface : 0.0;
+    detection.score = detection.depth_agreement * detection.color_agreement * ResidualFactor(detection.surface_error_m);
     if (options_.reject_plane_patches && detection.score > 0.0 &&
         OnLargerPlane(frame, rendered.depth, verified.surface)) {
       detection.score = 0.0;
     }
     return verified;
+  }
+
+  // 1 for a surface that fits the scene depth as closely as a right pose does (mean residual up to
+  // residual_free_m), falling linearly to 0 over residual_falloff_m beyond.
+  double ResidualFactor(double residual_m) const {
+    if (options_.residual_falloff_m <= 0.0) return 1.0;
+    return std::clamp(1.0 - (residual_m - options_.residual_free_m) / options_.residual_falloff_m, 0.0, 1.0);
   }
 
   // PatchOfLargerPlane for a rendered pose: its surface pixels against the scene points of a ring of
@@ -759,6 +771,7 @@ nlohmann::json RecognitionToJson(const RecognitionResult& result) {
                           {"depth_agreement", d.depth_agreement},
                           {"color_agreement", d.color_agreement},
                           {"visible_fraction", d.visible_fraction},
+                          {"surface_error", d.surface_error_m},
                           {"tracked", d.tracked}});
   }
   return {{"detections", detections}, {"timings_ms", result.timings_ms}, {"scene_primitives", result.scene_primitives}};

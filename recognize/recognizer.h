@@ -92,6 +92,12 @@ struct RecognizerOptions {
   /// off. On the same frames, 1.5 px raised recall at 0.07 false positives per frame from 18 to 20 of 35
   /// (with the earlier consistency tolerances of 1 cm and 0.2).
   double color_blur_px = 1.5;
+  /// ... times a factor for how closely the surface fits: 1 while the mean |rendered - scene depth| on those
+  /// pixels is at most residual_free_m, falling linearly to 0 over residual_falloff_m beyond (0: no factor).
+  /// A right pose after ICP fits to the sensor's noise (1-4 mm on YCB-Video); a wrong one that the 1.5 cm
+  /// tolerance lets through fits worse, e.g. a can whose curved side lies on a flat box face (4.5-5.3 mm).
+  double residual_free_m = 0.0035;
+  double residual_falloff_m = 0.003;
   double min_score = 0.3;  ///< detections below are dropped
   /// Tracking: a prior that was not itself tracked (a detection's first appearance) is followed only when it
   /// scored at least this; once followed, it is kept while it scores min_score. A false detection near
@@ -142,13 +148,15 @@ struct RecognizerOptions {
 /// One recognised object (the JSON of DESIGN.md "Interfaces").
 struct Detection {
   std::string model;
-  double score = 0.0;  ///< 0..1, higher is surer: depth agreement x colour correlation of the rendered model
+  /// 0..1, higher is surer: depth agreement x colour correlation of the rendered model x its fit factor
+  double score = 0.0;
   Eigen::Isometry3d camera_from_object = Eigen::Isometry3d::Identity();
   double inlier_fraction = 0.0;   ///< RANSAC inliers over the visible view primitives
   double fit_error_m = 0.0;       ///< RANSAC mean inlier distance, metres
   int view = -1;                  ///< library view that matched
   double depth_agreement = 0.0;   ///< share of the visible rendered pixels on the scene surface
   double color_agreement = 0.0;   ///< correlation of the rendered colours with the scene's on those, 0..1
+  double surface_error_m = 0.0;   ///< mean |rendered - scene depth| on those, metres
   double visible_fraction = 0.0;  ///< share of the rendered pixels the scene can show (not hidden, with depth)
   bool tracked = false;           ///< found from a prior (the previous frame's pose), without RANSAC
 };

@@ -194,6 +194,14 @@ class ContextHistograms {
 
 }  // namespace
 
+DescriptorOptions DescriptorOptions::SourceShells() {
+  DescriptorOptions options;
+  options.pairs = DescriptorPairs::kSource;
+  options.shells = 4;
+  options.radius_m = 0.045;
+  return options;
+}
+
 void DescriptorOptions::Check() const {
   if (max_neighbours < 0 || max_neighbours == 1) {
     ThrowInputError("descriptor options", "max_neighbours", "0 (all) or at least 2", std::to_string(max_neighbours));

@@ -35,12 +35,8 @@ enum class DescriptorAppearance : int {
 /// descriptor is soft_binning = false, hellinger = false with the pairs, appearance and weighting below at
 /// their defaults and max_neighbours 0.
 ///
-/// Issue 5's variant, pairs = kSource, shells = 4, radius_m = 0.045 (bench/RESULTS.md, 2026-11-22 06:12,
-/// discriminative_bench): mean score recognition tuning / held out / hard / easy tuning / easy held out
-/// 23.2 / 18.5 / 3.5 / 69.5 / 60.7 % against 11.9 / 11.1 / 1.7 / 68.3 / 55.3 for these defaults, and
-/// 39 instead of 1082 ms per view. The defaults below stay today's: libraries written before these fields
-/// existed must read as all pairs, one shell, 2.5 cm; use it through FeatureSettings
-/// (`ecvpose modeldb build --feature-settings`).
+/// The field defaults below are the paper's context (all pairs of a 2.5 cm ball, one shell) with this
+/// project's soft bins and Hellinger distance; model libraries are built with SourceShells() instead.
 struct DescriptorOptions {
   double radius_m = 0.025;  ///< context radius around each primitive, metres
   /// Context = at most this many of the primitives within the radius (the source included), spread evenly
@@ -72,6 +68,14 @@ struct DescriptorOptions {
   /// The largest gain measured: with source pairs at 3.5 cm, 1 / 2 / 4 shells give 12.4 / 18.2 / 20.1 %
   /// on recognition tuning.
   int shells = 1;
+
+  /// The context model libraries are built with (FeatureSettings): pairs of the source with each neighbour
+  /// (kSource) in 4 radial shells over 4.5 cm. discriminative_bench (bench/RESULTS.md, 2026-11-22 06:12), mean
+  /// score recognition tuning / held out / hard / easy tuning / easy held out: 23.2 / 18.5 / 3.5 / 69.5 /
+  /// 60.7 % against 11.9 / 11.1 / 1.7 / 68.3 / 55.3 for the field defaults, and 39 instead of 1082 ms per view.
+  /// End to end on the 30 YCB-Video frames (RANSAC seeds 1/2/3) with the recognizer's surface-fit factor:
+  /// 57 / 55 / 57 of 70 objects against 49 / 47 / 46 (bench/RESULTS.md, session 15).
+  static DescriptorOptions SourceShells();
 
   void Check() const;
 };

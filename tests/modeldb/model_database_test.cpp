@@ -6,6 +6,7 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "core/error.h"
 #include "modeldb/content_hash.h"
@@ -154,6 +155,36 @@ TEST(ModelDatabase, KeepsOneSetOfFeatureSettingsPerLibrary) {
   database.AddModel(test::SyntheticModel("a", 1, 10, 3));  // replacing the only model may change them
   EXPECT_TRUE(database.feature_settings()->descriptor.soft_binning);
   EXPECT_TRUE(database.LoadModels().at(0).record.features.descriptor.soft_binning);
+}
+
+// Libraries written before the descriptor's `pairs` and `shells` fields existed were built with all pairs in one
+// shell, and read so; a user's partial settings (`modeldb build --feature-settings`) take today's defaults.
+TEST(ModelDatabase, ReadsSettingsStoredWithoutTheNewerDescriptorFieldsAsTheyWereBuilt) {
+  test::TemporaryDirectory directory;
+  const std::string path = directory.File("old.sqlite");
+  {
+    ModelDatabase database(path, OpenMode::kCreate);
+    ModelRecord a = test::SyntheticModel("a", 1, 10, 1);
+    a.features = StoredFeatureDefaults();
+    database.AddModel(a);
+  }
+  {
+    nlohmann::json stored = nlohmann::json::parse(FeatureSettingsToJson(StoredFeatureDefaults()));
+    stored["descriptor"].erase("pairs");
+    stored["descriptor"].erase("shells");
+    SqlConnection raw(path, SqlOpenMode::kReadWrite, 1000);
+    raw.Prepare("UPDATE meta SET value = ? WHERE key = 'features'").Bind(1, stored.dump()).Run();
+  }
+  const FeatureSettings old = *ModelDatabase(path, OpenMode::kReadOnly).feature_settings();
+  EXPECT_EQ(old.descriptor.pairs, DescriptorPairs::kAll);
+  EXPECT_EQ(old.descriptor.shells, 1);
+  EXPECT_EQ(old.descriptor.radius_m, 0.025);
+
+  const FeatureSettings partial = FeatureSettingsFromJson(R"({"descriptor": {"soft_binning": false}})", "test");
+  EXPECT_FALSE(partial.descriptor.soft_binning);
+  EXPECT_EQ(partial.descriptor.pairs, DescriptorPairs::kSource);
+  EXPECT_EQ(partial.descriptor.shells, 4);
+  EXPECT_EQ(partial.descriptor.radius_m, 0.045);
 }
 
 TEST(ModelDatabase, RefusesIncompleteRecords) {

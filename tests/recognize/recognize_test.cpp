@@ -179,6 +179,45 @@ TEST_F(RecognizeEndToEnd, AFirstDetectionBelowTheTrackStartScoreIsNotFollowed) {
   EXPECT_EQ(kept.scene_primitives, 0);
 }
 
+// Verification's surface-fit factor: the cracker box at its ground-truth pose fits the depth to the sensor's noise;
+// moved 9 mm back along its line of sight it still lies within the 1.5 cm depth tolerance almost everywhere,
+// but its mean residual (about 9 mm) is past residual_free_m + residual_falloff_m, so it scores 0.
+TEST_F(RecognizeEndToEnd, APoseAFewMillimetresOffTheSurfaceScoresZeroThroughItsResidual) {
+  LibraryLoadOptions load;
+  load.build_matchers = false;
+  load.names = {"003_cracker_box"};
+  const ModelLibrary library = ModelLibrary::Load(library_, load);
+  const LoadedFrame frame = LoadYcbvFrame(Frame());
+  const auto truth = std::find_if(frame.ground_truth.begin(), frame.ground_truth.end(),
+                                  [](const GroundTruth& g) { return g.object_name == "003_cracker_box"; });
+  ASSERT_NE(truth, frame.ground_truth.end());
+  RecognizerOptions options;
+  options.refine = false;  // verified at the prior's pose as it is
+  options.min_score = 0.0;
+  options.min_visible_fraction = 0.0;
+  auto verify = [&](const RecognizerOptions& settings, const Eigen::Isometry3d& pose) {
+    Detection prior;
+    prior.model = "003_cracker_box";
+    prior.camera_from_object = pose;
+    prior.tracked = true;
+    const RecognitionResult result = Recognizer(library, settings).Recognize(frame.rgbd, {prior});
+    EXPECT_EQ(result.detections.size(), 1U);
+    return result.detections.empty() ? Detection() : result.detections[0];
+  };
+  const Detection right = verify(options, truth->camera_from_object);
+  EXPECT_LT(right.surface_error_m, options.residual_free_m);
+  EXPECT_GT(right.score, 0.3);
+
+  Eigen::Isometry3d back = truth->camera_from_object;
+  back.translation() += 0.009 * back.translation().normalized();
+  const Detection off = verify(options, back);
+  EXPECT_GT(off.depth_agreement, 0.8);
+  EXPECT_GT(off.surface_error_m, options.residual_free_m + options.residual_falloff_m);
+  EXPECT_EQ(off.score, 0.0);
+  options.residual_falloff_m = 0.0;  // no factor: depth agreement and colour alone pass it
+  EXPECT_GT(verify(options, back).score, 0.3);
+}
+
 // The demo frame (video 0001) with the mustard bottle of video 0002's first frame pasted in over the cracker box,
 // at its ground-truth pose (PasteYcbvObject): two instances of one model on real pixels.
 TEST_F(RecognizeEndToEnd, FindsBothOfTwoMustardBottlesWhenAskedForTwoInstances) {
@@ -272,6 +311,9 @@ TEST(RecognizerOptions, OutOfRangeValuesAreReportedByName) {
   options = RecognizerOptions();
   options.min_score = 1.5;
   EXPECT_NE(message(options).find("min_score"), std::string::npos) << message(options);
+  options = RecognizerOptions();
+  options.residual_falloff_m = -0.001;
+  EXPECT_NE(message(options).find("residual_falloff_m"), std::string::npos) << message(options);
   options = RecognizerOptions();
   options.max_instances = 0;
   EXPECT_NE(message(options).find("max_instances"), std::string::npos) << message(options);
