@@ -143,9 +143,10 @@ using Method = std::function<PairScore(const ViewPair&, const PairPrimitives&)>;
 
 std::vector<std::pair<std::string, Method>> Methods() {
   std::vector<std::pair<std::string, Method>> methods;
-  methods.emplace_back("ECV context",
+  methods.emplace_back("ECV context, all pairs, r 2.5 cm",
                        [](const ViewPair& pair, const PairPrimitives& p) { return ScoreEcv(pair, p, {}, {}); });
-  methods.emplace_back("ECV source pairs, 4 shells, r 4.5 cm", [](const ViewPair& pair, const PairPrimitives& p) {
+  methods.emplace_back("ECV source pairs, 4 shells, r 4.5 cm (library default)", [](const ViewPair& pair,
+                                                                                   const PairPrimitives& p) {
     return ScoreEcv(pair, p, DescriptorOptions::SourceShells(), {});
   });
   auto add_pcl = [&](PclDescriptor descriptor, double radius_m, const std::string& suffix) {
@@ -264,7 +265,9 @@ cv::Mat BarChart(const std::vector<ViewPair>& pairs, const std::vector<std::stri
 
 // The paper's Fig. 6: 25 random ECV matches of one pair, green when true, red when false (BGR image).
 cv::Mat MatchPicture(const ViewPair& pair, const PairPrimitives& primitives) {
-  const Descriptors query = ComputeDescriptors(primitives.query), train = ComputeDescriptors(primitives.train);
+  const DescriptorOptions options = DescriptorOptions::SourceShells();  // the library default
+  const Descriptors query = ComputeDescriptors(primitives.query, options);
+  const Descriptors train = ComputeDescriptors(primitives.train, options);
   const DescriptorMatcher matcher(primitives.train, train);
   std::vector<DescriptorMatch> matches = matcher.Match(primitives.query, query);
   std::mt19937 random(5);
@@ -305,7 +308,7 @@ std::vector<Variant> Variants() {
     change(variant);
     variants.push_back(variant);
   };
-  add("**current defaults**", [](Variant&) {});
+  add("**field defaults** (all pairs, 2.5 cm; libraries use source pairs, 4 shells, 4.5 cm)", [](Variant&) {});
   add("paper's descriptor: signed, hard bins, L2, structure-specific", [](Variant& v) {
     v.descriptor.unsigned_segments = false;
     v.descriptor.soft_binning = false;
