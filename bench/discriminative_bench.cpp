@@ -219,12 +219,19 @@ std::string SetTable(const std::string& set, const std::vector<ViewPair>& pairs,
 }
 
 // Bar chart of the mean score per method and set, random matching as a grey tick (BGR image for imwrite).
+// ECV's variants in reds, the peers in blue-green to ochre (BGR).
+cv::Scalar MethodColor(const std::string& name, size_t index) {
+  if (name.rfind("ECV", 0) == 0) return index == 0 ? cv::Scalar(60, 60, 160) : cv::Scalar(40, 40, 230);
+  return {170 - 10.0 * static_cast<double>(index), 140, 60 + 12.0 * static_cast<double>(index)};
+}
+
 cv::Mat BarChart(const std::vector<ViewPair>& pairs, const std::vector<std::string>& names,
                  const std::vector<std::vector<PairScore>>& scores) {
   const std::vector<std::string> sets = {"recognition", "hard", "easy"};
   const int bar = 14, gap = 30, height = 300, top = 40, left = 50;
   const int group = static_cast<int>(names.size()) * bar;
-  cv::Mat canvas(top + height + 190, left + static_cast<int>(sets.size()) * (group + gap) + 20, CV_8UC3,
+  const int legend = 40 + 14 * static_cast<int>(names.size());
+  cv::Mat canvas(top + height + legend, left + static_cast<int>(sets.size()) * (group + gap) + 20, CV_8UC3,
                  cv::Scalar::all(255));
   for (int percent = 0; percent <= 100; percent += 20) {
     const int y = top + height - height * percent / 100;
@@ -244,7 +251,7 @@ cv::Mat BarChart(const std::vector<ViewPair>& pairs, const std::vector<std::stri
       }
       const double mean = count > 0 ? sum / count : 0.0;
       const int x = x0 + static_cast<int>(m) * bar;
-      const cv::Scalar color = m == 0 ? cv::Scalar(40, 40, 220) : cv::Scalar(170 - 10.0 * m, 140, 60 + 12.0 * m);
+      const cv::Scalar color = MethodColor(names[m], m);
       cv::rectangle(canvas, {x + 1, top + height - static_cast<int>(height * mean)}, {x + bar - 2, top + height}, color,
                     cv::FILLED);
       const int random_y = top + height - static_cast<int>(height * (count > 0 ? random / count : 0.0));
@@ -253,7 +260,7 @@ cv::Mat BarChart(const std::vector<ViewPair>& pairs, const std::vector<std::stri
     cv::putText(canvas, sets[s], {x0, top + height + 18}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar::all(0));
   }
   for (size_t m = 0; m < names.size(); ++m) {
-    const cv::Scalar color = m == 0 ? cv::Scalar(40, 40, 220) : cv::Scalar(170 - 10.0 * m, 140, 60 + 12.0 * m);
+    const cv::Scalar color = MethodColor(names[m], m);
     const int y = top + height + 40 + static_cast<int>(m) * 14;
     cv::rectangle(canvas, {left, y - 9}, {left + 10, y}, color, cv::FILLED);
     cv::putText(canvas, names[m], {left + 16, y}, cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar::all(0));
