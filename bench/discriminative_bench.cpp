@@ -145,10 +145,10 @@ std::vector<std::pair<std::string, Method>> Methods() {
   std::vector<std::pair<std::string, Method>> methods;
   methods.emplace_back("ECV context, all pairs, r 2.5 cm",
                        [](const ViewPair& pair, const PairPrimitives& p) { return ScoreEcv(pair, p, {}, {}); });
-  methods.emplace_back("ECV source pairs, 4 shells, r 4.5 cm (library default)", [](const ViewPair& pair,
-                                                                                   const PairPrimitives& p) {
-    return ScoreEcv(pair, p, DescriptorOptions::SourceShells(), {});
-  });
+  methods.emplace_back("ECV source pairs, 4 shells, r 4.5 cm (library default)",
+                       [](const ViewPair& pair, const PairPrimitives& p) {
+                         return ScoreEcv(pair, p, DescriptorOptions::SourceShells(), {});
+                       });
   auto add_pcl = [&](PclDescriptor descriptor, double radius_m, const std::string& suffix) {
     methods.emplace_back(
         std::string(ToString(descriptor)) + " @ECV" + suffix,

@@ -35,9 +35,10 @@ std::vector<Primitive> RandomPrimitives(int count, unsigned seed) {
   return primitives;
 }
 
-// The descriptor variants beyond the paper's (issue 5), each with one option changed from the defaults.
+// The descriptor variants beyond the paper's (issue 5), each with one option changed from the field defaults, and
+// the libraries' default (SourceShells: source pairs, 4 shells, 4.5 cm).
 std::vector<std::pair<std::string, DescriptorOptions>> Variants() {
-  std::vector<std::pair<std::string, DescriptorOptions>> variants(6);
+  std::vector<std::pair<std::string, DescriptorOptions>> variants(7);
   variants[0].first = "defaults";
   variants[1].first = "source pairs";
   variants[1].second.pairs = DescriptorPairs::kSource;
@@ -49,6 +50,7 @@ std::vector<std::pair<std::string, DescriptorOptions>> Variants() {
   variants[4].second.appearance = DescriptorAppearance::kMonogenic;
   variants[5].first = "two shells";
   variants[5].second.shells = 2;
+  variants[6] = {"source pairs in 4 shells (library default)", DescriptorOptions::SourceShells()};
   return variants;
 }
 
