@@ -42,6 +42,8 @@ struct RecognizerOptions {
   /// video 0000, 128 took 1.63 s instead of 2.98 s per frame (96: 1.04 s). Over the 30 frames, RANSAC seeds
   /// 1/2/3, 128 found 49/43/44 of 70 objects as without a cap (96: 49/42/43), with 7 instead of 6 false
   /// positives in the 90 frames. (Session 5, at 3 views per model, 64 found 7 instead of 9 of 10 in video 0000.)
+  /// The shell context (the libraries' default since session 15) costs linearly, but the cap still pays: seed 1,
+  /// no cap 53 of 70 objects with 13 false positives, 64: 47 / 11, 96: 52 / 9, 128: 57 / 6.
   int scene_max_neighbours = 128;
   /// A scene with more primitives than this describes only every n-th of them (the smallest n that keeps the
   /// sources at or under it); all of them still form the contexts. 0: every primitive. On YCB-Video only the
