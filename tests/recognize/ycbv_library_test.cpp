@@ -18,7 +18,7 @@
 namespace ecv {
 namespace {
 
-constexpr int kFoundAtLeast = 6;  // of 7 (all but the potted meat can of 0002)
+constexpr int kFoundAtLeast = 6;  // of 7: all but the banana of 0002 (with the all-pairs context: the potted meat can)
 
 class YcbvLibrary : public ::testing::Test {
  protected:
