@@ -21,6 +21,14 @@
 namespace ecv {
 namespace {
 
+// The frame's ground truth of `model`, or null.
+const GroundTruth* TruthOf(const LoadedFrame& frame, const std::string& model) {
+  for (const GroundTruth& truth : frame.ground_truth) {
+    if (truth.object_name == model) return &truth;
+  }
+  return nullptr;
+}
+
 class RecognizeEndToEnd : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -33,6 +41,14 @@ class RecognizeEndToEnd : public ::testing::Test {
   static void TearDownTestSuite() { delete directory_; }
 
   static std::string Frame() { return std::string(ECV_SOURCE_DIR) + "/models/frame/000001"; }
+
+  // The library built for the suite (only `names`, when given), without matchers: the Recognizer makes its own.
+  static ModelLibrary Library(const std::vector<std::string>& names = {}) {
+    LibraryLoadOptions load;
+    load.build_matchers = false;
+    load.names = names;
+    return ModelLibrary::Load(library_, load);
+  }
 
   static test::TemporaryDirectory* directory_;
   static std::string library_;
@@ -48,9 +64,7 @@ TEST_F(RecognizeEndToEnd, FindsTheObjectsOfTheDemoFrameWithinTenthOfTheirDiamete
   ASSERT_EQ(run.exit_code, 0) << run.output;
 
   const LoadedFrame frame = LoadYcbvFrame(Frame());
-  LibraryLoadOptions load;
-  load.build_matchers = false;
-  const ModelLibrary library = ModelLibrary::Load(library_, load);
+  const ModelLibrary library = Library();
   std::vector<EvalModel> models;
   for (const LibraryModel& model : library.models()) models.push_back(EvalModelFromRecord(model.record));
   const std::vector<Detection> detections = DetectionsFromJson(ReadJsonFile(json), json);
@@ -91,9 +105,8 @@ TEST_F(RecognizeEndToEnd, RankViewsListsEveryViewBestFirstAndRanksARightViewFirs
       EXPECT_LE(view.correspondences.size(), static_cast<size_t>(RecognizerOptions().consistency_max_correspondences));
     }
   }
-  const auto truth = std::find_if(frame.ground_truth.begin(), frame.ground_truth.end(),
-                                  [](const GroundTruth& t) { return t.object_name == "003_cracker_box"; });
-  ASSERT_NE(truth, frame.ground_truth.end());
+  const GroundTruth* truth = TruthOf(frame, "003_cracker_box");
+  ASSERT_NE(truth, nullptr);
   const Eigen::Isometry3f camera_from_object = truth->camera_from_object.cast<float>();
   const RankedView& first = ranked.at("003_cracker_box").front();
   const auto right = std::count_if(first.correspondences.begin(), first.correspondences.end(), [&](const auto& pair) {
@@ -115,9 +128,7 @@ TEST_F(RecognizeEndToEnd, SameSeedSameDetections) {
 }
 
 TEST_F(RecognizeEndToEnd, TheSameFrameTwiceGivesTheSameDetectionsAndTheFrameIsLeftAlone) {
-  LibraryLoadOptions load;
-  load.build_matchers = false;
-  const ModelLibrary library = ModelLibrary::Load(library_, load);
+  const ModelLibrary library = Library();
   const LoadedFrame frame = LoadYcbvFrame(Frame());
   const cv::Mat color = frame.rgbd.color.clone(), depth = frame.rgbd.depth.clone();
   Recognizer recognizer(library);
@@ -131,10 +142,7 @@ TEST_F(RecognizeEndToEnd, TheSameFrameTwiceGivesTheSameDetectionsAndTheFrameIsLe
 }
 
 TEST_F(RecognizeEndToEnd, WhenEveryModelIsTrackedNoPrimitivesAreExtracted) {
-  LibraryLoadOptions load;
-  load.build_matchers = false;
-  load.names = {"003_cracker_box", "006_mustard_bottle"};  // both found in the demo frame
-  const ModelLibrary library = ModelLibrary::Load(library_, load);
+  const ModelLibrary library = Library({"003_cracker_box", "006_mustard_bottle"});  // both found in the demo frame
   const LoadedFrame frame = LoadYcbvFrame(Frame());
   Recognizer recognizer(library);
   const RecognitionResult found = recognizer.Recognize(frame.rgbd);
@@ -146,9 +154,8 @@ TEST_F(RecognizeEndToEnd, WhenEveryModelIsTrackedNoPrimitivesAreExtracted) {
   EXPECT_EQ(tracked.timings_ms.count("track"), 1U);
   for (const Detection& detection : tracked.detections) {
     EXPECT_TRUE(detection.tracked) << detection.model;
-    const auto truth = std::find_if(frame.ground_truth.begin(), frame.ground_truth.end(),
-                                    [&](const GroundTruth& g) { return g.object_name == detection.model; });
-    ASSERT_NE(truth, frame.ground_truth.end());
+    const GroundTruth* truth = TruthOf(frame, detection.model);
+    ASSERT_NE(truth, nullptr);
     // Found at 1.4 mm / 2.0 deg and 3.8 mm / 3.7 deg; ICP from there stays near the truth.
     EXPECT_LT(TranslationDistance(detection.camera_from_object, truth->camera_from_object), 0.008) << detection.model;
     EXPECT_LT(RotationAngle(detection.camera_from_object, truth->camera_from_object), 6.0 * M_PI / 180.0)
@@ -158,10 +165,7 @@ TEST_F(RecognizeEndToEnd, WhenEveryModelIsTrackedNoPrimitivesAreExtracted) {
 }
 
 TEST_F(RecognizeEndToEnd, AFirstDetectionBelowTheTrackStartScoreIsNotFollowed) {
-  LibraryLoadOptions load;
-  load.build_matchers = false;
-  load.names = {"003_cracker_box"};
-  const ModelLibrary library = ModelLibrary::Load(library_, load);
+  const ModelLibrary library = Library({"003_cracker_box"});
   const LoadedFrame frame = LoadYcbvFrame(Frame());
   RecognizerOptions options;
   std::vector<Detection> priors = Recognizer(library, options).Recognize(frame.rgbd).detections;
@@ -183,14 +187,10 @@ TEST_F(RecognizeEndToEnd, AFirstDetectionBelowTheTrackStartScoreIsNotFollowed) {
 // moved 9 mm back along its line of sight it still lies within the 1.5 cm depth tolerance almost everywhere,
 // but its mean residual (about 9 mm) is past residual_free_m + residual_falloff_m, so it scores 0.
 TEST_F(RecognizeEndToEnd, APoseAFewMillimetresOffTheSurfaceScoresZeroThroughItsResidual) {
-  LibraryLoadOptions load;
-  load.build_matchers = false;
-  load.names = {"003_cracker_box"};
-  const ModelLibrary library = ModelLibrary::Load(library_, load);
+  const ModelLibrary library = Library({"003_cracker_box"});
   const LoadedFrame frame = LoadYcbvFrame(Frame());
-  const auto truth = std::find_if(frame.ground_truth.begin(), frame.ground_truth.end(),
-                                  [](const GroundTruth& g) { return g.object_name == "003_cracker_box"; });
-  ASSERT_NE(truth, frame.ground_truth.end());
+  const GroundTruth* truth = TruthOf(frame, "003_cracker_box");
+  ASSERT_NE(truth, nullptr);
   RecognizerOptions options;
   options.refine = false;  // verified at the prior's pose as it is
   options.min_score = 0.0;
@@ -225,9 +225,7 @@ TEST_F(RecognizeEndToEnd, FindsBothOfTwoMustardBottlesWhenAskedForTwoInstances) 
       LoadYcbvFrame(Frame()), test::DataPath("ycbv_subset/Example-Scenes/0002/000001"), "006_mustard_bottle");
   const std::string frame = directory_->File("two_bottles.json");
   WriteFrameJson(frame, scene.rgbd);
-  LibraryLoadOptions load;
-  load.build_matchers = false;
-  const ModelLibrary library = ModelLibrary::Load(library_, load);
+  const ModelLibrary library = Library();
   std::vector<EvalModel> models;
   for (const LibraryModel& model : library.models()) models.push_back(EvalModelFromRecord(model.record));
   auto bottles = [&](const std::string& flags, FrameEvaluation* evaluation) {
