@@ -5,10 +5,12 @@
 // or more right ones (RANSAC then has a chance). Also: the consistent set the ranking could find among the right
 // correspondences alone, and the scores of models that are not in the frame (the noise the right view must
 // stand out of). No RANSAC, no verification: a ranking change is judged here in a minute before the
-// end-to-end runs of recognize_bench.
+// end-to-end runs of recognize_bench. With --lmo, the LM-O frame of recognize_bench instead (its library).
 //
 //   scripts/build_ycbv_library /tmp/ycbv.sqlite --views 40 --distance 0.9
 //   ranking_bench --db /tmp/ycbv.sqlite [--seed 1] [--results bench/RESULTS.md]
+//   scripts/build_lmo_library /tmp/lmo.sqlite --views 40 --distance 1.0
+//   ranking_bench --db /tmp/lmo.sqlite --lmo
 
 #include <algorithm>
 #include <cstring>
@@ -59,13 +61,25 @@ struct ModelTally {
   std::vector<double> most_right, clique_of_most_right, top_score, best_good_score, absent_top_score;
 };
 
-std::string Run(const ModelLibrary& library, const RecognizerOptions& options, std::vector<double>* ms) {
+// The 30 YCB-Video frames, or LM-O test scene 000002, image 3 (the one LM-O image with depth: SAM-6D's example
+// depth, see lmo_subset/SOURCE.md).
+std::vector<LoadedFrame> Frames(bool lmo) {
+  if (lmo) {
+    const std::string scenes = std::string(ECV_DATA_DIR) + "/lmo_subset";
+    return {LoadBopFrame(scenes + "/data/bop/lmo/test/000002", 3, scenes + "/SAM-6D/Data/Example/depth.png")};
+  }
+  std::vector<LoadedFrame> frames;
+  for (const std::string& prefix : YcbvFramePrefixes(ECV_DATA_DIR)) frames.push_back(LoadYcbvFrame(prefix));
+  return frames;
+}
+
+std::string Run(const ModelLibrary& library, const RecognizerOptions& options, const std::vector<LoadedFrame>& frames,
+                std::vector<double>* ms) {
   Recognizer recognizer(library, options);
   std::map<std::string, ModelTally> tallies;
   std::map<std::string, double> diameters;
   for (const LibraryModel& model : library.models()) diameters[model.record.name] = model.record.diameter_m;
-  for (const std::string& prefix : YcbvFramePrefixes(ECV_DATA_DIR)) {
-    const LoadedFrame frame = LoadYcbvFrame(prefix);
+  for (const LoadedFrame& frame : frames) {
     const Clock::time_point start = Clock::now();
     const std::map<std::string, std::vector<RankedView>> ranked = recognizer.RankViews(frame.rgbd);
     ms->push_back(MillisecondsSince(start));
@@ -100,7 +114,7 @@ std::string Run(const ModelLibrary& library, const RecognizerOptions& options, s
     for (const auto& [name, views] : ranked) {
       if (present.count(name) == 0 && !views.empty()) tallies[name].absent_top_score.push_back(views.front().score);
     }
-    std::cerr << "ranking_bench: " << prefix << "\n";
+    std::cerr << "ranking_bench: " << frame.rgbd.name << "\n";
   }
 
   std::ostringstream table;
@@ -129,12 +143,15 @@ int Main(int argc, char** argv) {
   std::string db, results = std::string(ECV_SOURCE_DIR) + "/bench/RESULTS.md";
   RecognizerOptions options;
   options.ransac.threads = 1;
+  bool lmo = false;
   for (int i = 1; i < argc; ++i) {
     const bool has_value = i + 1 < argc;
     if (has_value && std::strcmp(argv[i], "--db") == 0) {
       db = argv[++i];
     } else if (has_value && std::strcmp(argv[i], "--results") == 0) {
       results = argv[++i];
+    } else if (std::strcmp(argv[i], "--lmo") == 0) {
+      lmo = true;
     } else if (has_value && std::strcmp(argv[i], "--seed") == 0) {
       options.ransac.seed = std::stoull(argv[++i]);
     } else {
@@ -143,24 +160,26 @@ int Main(int argc, char** argv) {
     }
   }
   if (db.empty()) {
-    std::cerr << "usage: ranking_bench --db LIB.sqlite [--seed N] [--results FILE]\n"
-                 "  (LIB: the 7 textured YCB-Video models, scripts/build_ycbv_library LIB --views 40 --distance 0.9)\n";
+    std::cerr << "usage: ranking_bench --db LIB.sqlite [--lmo] [--seed N] [--results FILE]\n"
+                 "  (LIB: the 7 textured YCB-Video models, scripts/build_ycbv_library LIB --views 40 --distance 0.9;\n"
+                 "  with --lmo the LM-O frame, scripts/build_lmo_library LIB --views 40 --distance 1.0)\n";
     return 2;
   }
   const ModelLibrary library = ModelLibrary::Load(db);
   std::vector<double> ms;
-  const std::string table = Run(library, options, &ms);
+  const std::string table = Run(library, options, Frames(lmo), &ms);
   std::ostringstream markdown;
   markdown << "Library `" << db << "` (" << library.models().size() << " models), the " << ms.size()
-           << " YCB-Video frames, seed " << options.ransac.seed << " (it picks each view's "
-           << options.consistency_max_correspondences
+           << (lmo ? " LM-O frame (scene 000002, image 3)" : " YCB-Video frames") << ", seed " << options.ransac.seed
+           << " (it picks each view's " << options.consistency_max_correspondences
            << " ranking descriptors), one thread. Right = the ground truth puts the view primitive within "
            << kRightM * 100.0F << " cm of its scene primitive; good view = " << kGoodView
            << " or more right. Score = the ranking's consistent-set size. Median ms per frame for describing the "
               "scene and ranking every view: "
            << Fixed(Median(ms), 0) << ".\n\n"
            << table;
-  Report(results, "View ranking on YCB-Video (ranking_bench)", CommandLine(argc, argv), markdown.str());
+  Report(results, lmo ? "View ranking on LM-O (ranking_bench)" : "View ranking on YCB-Video (ranking_bench)",
+         CommandLine(argc, argv), markdown.str());
   return 0;
 }
 

@@ -140,10 +140,19 @@ BuildResult BuildModel(const ModelSource& source, const ModelBuildOptions& optio
   record.object_from_mesh = source.object_from_mesh;
   record.diameter_m = mesh.Diameter();
   record.symmetric = source.symmetric;
-  record.build_options_json = BuildOptionsToJson(options);
+  ModelBuildOptions shaded = options;
+  shaded.render.shading = ViewShading(mesh, options);
+  record.build_options_json = BuildOptionsToJson(shaded);
   record.features = options.features;
-  record.views = BuildModelViews(mesh, options, renderer, progress, &result.timings);
+  record.views = BuildModelViews(mesh, shaded, renderer, progress, &result.timings);
   return result;
+}
+
+Shading ViewShading(const TriangleMesh& mesh, const ModelBuildOptions& options) {
+  const bool textured = std::any_of(mesh.parts.begin(), mesh.parts.end(), [&](const MeshPart& part) {
+    return mesh.Coloring(part) == MeshColoring::kTexture;
+  });
+  return options.shade_untextured && !textured ? Shading::kHeadlight : options.render.shading;
 }
 
 std::string BuildOptionsToJson(const ModelBuildOptions& options) {

@@ -33,7 +33,7 @@ struct ModeldbArgs {
   std::string camera;
   std::string size = "640x480";
   double distance_m = ModelBuildOptions().distance_m;
-  std::string shading = "unlit";
+  std::string shading = "auto";
   bool symmetric = false;
   std::string feature_settings;  // JSON file of FeatureSettings; empty: the defaults
   int threads = app::AllCores();
@@ -75,6 +75,7 @@ ModelBuildOptions BuildArguments(const ModeldbArgs& args) {
   options.threads = args.threads;
   options.camera = CameraArgument(args);
   options.render.shading = args.shading == "headlight" ? Shading::kHeadlight : Shading::kUnlit;
+  options.shade_untextured = args.shading == "auto";
   if (!args.feature_settings.empty()) {  // --feature-settings: e.g. {"descriptor": {"pairs": 1}}
     std::ifstream file(args.feature_settings);
     std::stringstream text;
@@ -311,8 +312,11 @@ void AddBuildFlags(CLI::App& build, ModeldbArgs* args) {
                   "Camera distance from the object centre, metres; farther if the object would not fit (0: fit)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
-  build.add_option("--shading", args->shading, "unlit (texture colours as stored) or headlight")
-      ->check(CLI::IsMember({"unlit", "headlight"}))
+  build
+      .add_option("--shading", args->shading,
+                  "auto (headlight for meshes without a texture, unlit for textured ones), unlit (colours as "
+                  "stored) or headlight")
+      ->check(CLI::IsMember({"auto", "unlit", "headlight"}))
       ->capture_default_str();
   build.add_flag("--symmetric", args->symmetric, "Mark the models symmetric (evaluated with ADD-S)");
   build

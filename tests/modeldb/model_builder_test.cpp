@@ -143,6 +143,44 @@ TEST_F(BuiltModel, RepeatsBitForBitAndSurvivesStorage) {
   }
 }
 
+// Mean brightness of a record's primitive colours (RGB in [0, 1]).
+double MeanBrightness(const ModelRecord& record) {
+  double sum = 0.0;
+  size_t count = 0;
+  for (const ModelView& view : record.views) {
+    for (const Primitive& primitive : view.primitives) sum += primitive.color.mean();
+    count += view.primitives.size();
+  }
+  return count > 0 ? sum / static_cast<double>(count) : 0.0;
+}
+
+// A vertex-coloured scan (LM-O's watering can) gets headlight-shaded views, a textured mesh its texture as stored;
+// the choice is recorded with the build, and shade_untextured = false or --shading unlit turns it off.
+TEST(ModelBuilder, ShadesMeshesWithoutATextureAndKeepsTexturesAsStored) {
+  ModelSource can;
+  can.mesh_path = test::DataPath("lmo_subset/data/bop/lmo/models/obj_000005.ply");
+  can.unit = "mm";
+  ModelBuildOptions options = FewSmallViews(2);
+  const TriangleMesh can_mesh = LoadMesh(can.mesh_path, {0.001, Eigen::Isometry3d::Identity(), false});
+  const TriangleMesh box_mesh = LoadMesh(CrackerBox().mesh_path, {1.0, CrackerBox().object_from_mesh, false});
+  EXPECT_EQ(ViewShading(can_mesh, options), Shading::kHeadlight);
+  EXPECT_EQ(ViewShading(box_mesh, options), Shading::kUnlit);
+  options.render.shading = Shading::kHeadlight;
+  EXPECT_EQ(ViewShading(box_mesh, options), Shading::kHeadlight);
+
+  Renderer renderer;
+  const BuildResult shaded = BuildModel(can, FewSmallViews(2), renderer);
+  ModelBuildOptions flat = FewSmallViews(2);
+  flat.shade_untextured = false;
+  EXPECT_EQ(ViewShading(can_mesh, flat), Shading::kUnlit);
+  const BuildResult unlit = BuildModel(can, flat, renderer);
+  EXPECT_THAT(shaded.record.build_options_json, HasSubstr("\"shading\":\"headlight\""));
+  EXPECT_THAT(unlit.record.build_options_json, HasSubstr("\"shading\":\"unlit\""));
+  // Headlight scales each colour by 0.35 + 0.65 |cos(incidence)| <= 1: a curved can comes out darker.
+  EXPECT_LT(MeanBrightness(shaded.record), 0.95 * MeanBrightness(unlit.record));
+  EXPECT_GT(MeanBrightness(shaded.record), 0.5 * MeanBrightness(unlit.record));
+}
+
 TEST(ModelBuilder, RejectsBadOptionsAndMeshes) {
   Renderer renderer;
   ModelBuildOptions options = FewSmallViews(0);
