@@ -170,6 +170,12 @@ std::string BuildOptionsToJson(const ModelBuildOptions& options) {
   return json.dump();
 }
 
+Shading StoredViewShading(const std::string& build_options_json) {
+  const nlohmann::json json = nlohmann::json::parse(build_options_json, nullptr, false);
+  const bool headlight = json.is_object() && json.value("shading", std::string("unlit")) == "headlight";
+  return headlight ? Shading::kHeadlight : Shading::kUnlit;
+}
+
 std::vector<std::string> MeshContentFiles(const std::string& mesh_path, const TriangleMesh& mesh) {
   std::vector<std::string> files = {mesh_path};
   for (const MeshMaterial& material : mesh.materials) {

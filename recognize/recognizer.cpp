@@ -23,6 +23,7 @@
 #include "ecv/primitives.h"
 #include "io/mesh_io.h"
 #include "io/pose_io.h"
+#include "modeldb/model_builder.h"
 #include "recognize/scoring.h"
 #include "render/overlay.h"
 #include "render/renderer.h"
@@ -223,6 +224,9 @@ class Recognizer::Impl {
         meshes[i] = LoadMesh(records_[first + i].mesh_path, load);
       });
       for (const TriangleMesh& mesh : meshes) meshes_.push_back(renderer_.AddMesh(mesh));
+    }
+    for (const LibraryModel& model : models) {
+      render_options_.emplace_back().shading = StoredViewShading(model.record.build_options_json);
     }
   }
 
@@ -575,7 +579,7 @@ class Recognizer::Impl {
     const RgbdFrame& frame = *scene.frame;
     const int stride = options_.dense_stride_px;
     const PinholeCamera camera = frame.camera.Sampled(stride);
-    const RenderResult rendered = renderer_.Render(meshes_[model], camera, hypothesis.pose);
+    const RenderResult rendered = renderer_.Render(meshes_[model], camera, hypothesis.pose, render_options_[model]);
     cv::Mat model_color;
     if (options_.color_blur_px > 0.0) {
       cv::GaussianBlur(rendered.color, model_color, cv::Size(0, 0), options_.color_blur_px / stride);
@@ -736,6 +740,7 @@ class Recognizer::Impl {
   std::vector<ModelRecord> records_;  // per model: the library's, colours mapped by its colour matrix if any
   Renderer renderer_;
   std::vector<MeshId> meshes_;
+  std::vector<RenderOptions> render_options_;  // per model: shaded as its library views are
 };
 
 Recognizer::Recognizer(const ModelLibrary& library, const RecognizerOptions& options)

@@ -176,6 +176,10 @@ TEST(ModelBuilder, ShadesMeshesWithoutATextureAndKeepsTexturesAsStored) {
   const BuildResult unlit = BuildModel(can, flat, renderer);
   EXPECT_THAT(shaded.record.build_options_json, HasSubstr("\"shading\":\"headlight\""));
   EXPECT_THAT(unlit.record.build_options_json, HasSubstr("\"shading\":\"unlit\""));
+  // What the recognizer reads back to render the model in verification as its views were rendered.
+  EXPECT_EQ(StoredViewShading(shaded.record.build_options_json), Shading::kHeadlight);
+  EXPECT_EQ(StoredViewShading(unlit.record.build_options_json), Shading::kUnlit);
+  EXPECT_EQ(StoredViewShading("{\"views\": 40}"), Shading::kUnlit);  // built before the choice was recorded
   // Headlight scales each colour by 0.35 + 0.65 |cos(incidence)| <= 1: a curved can comes out darker.
   EXPECT_LT(MeanBrightness(shaded.record), 0.95 * MeanBrightness(unlit.record));
   EXPECT_GT(MeanBrightness(shaded.record), 0.5 * MeanBrightness(unlit.record));
