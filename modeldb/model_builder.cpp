@@ -172,7 +172,7 @@ std::string BuildOptionsToJson(const ModelBuildOptions& options) {
 
 Shading StoredViewShading(const std::string& build_options_json) {
   const nlohmann::json json = nlohmann::json::parse(build_options_json, nullptr, false);
-  const bool headlight = json.is_object() && json.value("shading", std::string("unlit")) == "headlight";
+  const bool headlight = json.is_object() && json.contains("shading") && json["shading"] == "headlight";
   return headlight ? Shading::kHeadlight : Shading::kUnlit;
 }
 

@@ -180,6 +180,8 @@ TEST(ModelBuilder, ShadesMeshesWithoutATextureAndKeepsTexturesAsStored) {
   EXPECT_EQ(StoredViewShading(shaded.record.build_options_json), Shading::kHeadlight);
   EXPECT_EQ(StoredViewShading(unlit.record.build_options_json), Shading::kUnlit);
   EXPECT_EQ(StoredViewShading("{\"views\": 40}"), Shading::kUnlit);  // built before the choice was recorded
+  EXPECT_EQ(StoredViewShading("{\"shading\": 1}"), Shading::kUnlit);
+  EXPECT_EQ(StoredViewShading("not json"), Shading::kUnlit);
   // Headlight scales each colour by 0.35 + 0.65 |cos(incidence)| <= 1: a curved can comes out darker.
   EXPECT_LT(MeanBrightness(shaded.record), 0.95 * MeanBrightness(unlit.record));
   EXPECT_GT(MeanBrightness(shaded.record), 0.5 * MeanBrightness(unlit.record));
