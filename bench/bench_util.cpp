@@ -54,6 +54,11 @@ double Mean(const std::vector<double>& values) {
   return std::accumulate(values.begin(), values.end(), 0.0) / static_cast<double>(values.size());
 }
 
+LoadedFrame LmoFrame(const std::string& data_dir) {
+  const std::string lmo = data_dir + "/lmo_subset";
+  return LoadBopFrame(lmo + "/data/bop/lmo/test/000002", 3, lmo + "/SAM-6D/Data/Example/depth.png");
+}
+
 std::vector<std::string> YcbvFramePrefixes(const std::string& data_dir) {
   std::vector<std::string> prefixes;
   const std::string suffix = "-color.png";

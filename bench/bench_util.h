@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "io/frame_io.h"
+
 namespace ecv::bench {
 
 using Clock = std::chrono::steady_clock;
@@ -29,6 +31,10 @@ double Mean(const std::vector<double>& values);
 /// The frame prefixes ("DIR/0001/000001") of YCB-Video's subset under `data_dir` (ycbv_subset/Example-Scenes),
 /// sorted: the 30 frames of videos 0000-0002.
 std::vector<std::string> YcbvFramePrefixes(const std::string& data_dir);
+
+/// LM-O test scene 000002, image 3 under `data_dir` (lmo_subset): the one LM-O image with depth (SAM-6D's example
+/// depth, see lmo_subset/SOURCE.md).
+LoadedFrame LmoFrame(const std::string& data_dir);
 
 /// Prints `markdown` and appends it to `results_path` under a heading with `title`, the date, the machine
 /// and the command.

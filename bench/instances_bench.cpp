@@ -29,12 +29,6 @@ std::string Prefix(const std::string& frame) {
   return std::string(ECV_DATA_DIR) + "/ycbv_subset/Example-Scenes/" + frame;
 }
 
-std::vector<EvalModel> EvalModels(const ModelLibrary& library) {
-  std::vector<EvalModel> models;
-  for (const LibraryModel& model : library.models()) models.push_back(EvalModelFromRecord(model.record));
-  return models;
-}
-
 // One setting over the seeds, on the two-bottle frame.
 struct SeedRuns {
   int both_correct = 0;     // runs with both bottles within ADD < 0.1 d

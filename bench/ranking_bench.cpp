@@ -61,13 +61,9 @@ struct ModelTally {
   std::vector<double> most_right, clique_of_most_right, top_score, best_good_score, absent_top_score;
 };
 
-// The 30 YCB-Video frames, or LM-O test scene 000002, image 3 (the one LM-O image with depth: SAM-6D's example
-// depth, see lmo_subset/SOURCE.md).
+// The 30 YCB-Video frames, or the LM-O frame of recognize_bench.
 std::vector<LoadedFrame> Frames(bool lmo) {
-  if (lmo) {
-    const std::string scenes = std::string(ECV_DATA_DIR) + "/lmo_subset";
-    return {LoadBopFrame(scenes + "/data/bop/lmo/test/000002", 3, scenes + "/SAM-6D/Data/Example/depth.png")};
-  }
+  if (lmo) return {LmoFrame(ECV_DATA_DIR)};
   std::vector<LoadedFrame> frames;
   for (const std::string& prefix : YcbvFramePrefixes(ECV_DATA_DIR)) frames.push_back(LoadYcbvFrame(prefix));
   return frames;

@@ -48,11 +48,8 @@ std::vector<NamedFrame> YcbvFrames(const std::string& data, int limit, int step)
   return frames;
 }
 
-// LM-O test scene 000002, image 3: the one LM-O image with depth (SAM-6D's example depth, see lmo_subset/SOURCE.md).
 std::vector<NamedFrame> LmoFrames(const std::string& data) {
-  const std::string lmo = data + "/lmo_subset";
-  return {{"lmo/000002/000003",
-           LoadBopFrame(lmo + "/data/bop/lmo/test/000002", 3, lmo + "/SAM-6D/Data/Example/depth.png")}};
+  return {{"lmo/000002/000003", LmoFrame(data)}};
 }
 
 struct Run {
@@ -275,8 +272,7 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
   LibraryLoadOptions load;
   load.build_matchers = false;
   const ModelLibrary library = ModelLibrary::Load(db, load);
-  std::vector<EvalModel> models;
-  for (const LibraryModel& model : library.models()) models.push_back(EvalModelFromRecord(model.record));
+  const std::vector<EvalModel> models = EvalModels(library);
   *notes << "Library: " << library.models().size() << " models, " << library.NumViews() << " views (`" << db
          << "`); models with a colour matrix: "
          << std::count_if(library.models().begin(), library.models().end(),

@@ -66,8 +66,7 @@ int RunEval(const EvalArgs& args) {
   LibraryLoadOptions load;
   load.build_matchers = false;
   const ModelLibrary library = ModelLibrary::Load(args.db, load);
-  std::vector<EvalModel> models;
-  for (const LibraryModel& model : library.models()) models.push_back(EvalModelFromRecord(model.record));
+  const std::vector<EvalModel> models = EvalModels(library);
 
   std::vector<FrameEvaluation> frames;
   if (!args.frame.positional.empty()) {

@@ -36,6 +36,12 @@ EvalModel EvalModelFromRecord(const ModelRecord& record, size_t max_points) {
   return model;
 }
 
+std::vector<EvalModel> EvalModels(const ModelLibrary& library) {
+  std::vector<EvalModel> models;
+  for (const LibraryModel& model : library.models()) models.push_back(EvalModelFromRecord(model.record));
+  return models;
+}
+
 PoseError ComputePoseError(const std::vector<Eigen::Vector3f>& points, const Eigen::Isometry3d& estimate,
                            const Eigen::Isometry3d& truth) {
   PoseError error;

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/pose.h"
+#include "modeldb/model_library.h"
 #include "modeldb/model_record.h"
 #include "recognize/recognizer.h"
 
@@ -35,6 +36,9 @@ struct EvalModel {
 /// A model's evaluation points (at most `max_points` vertices of its mesh, object frame), diameter and
 /// symmetry, from its library record. Throws InputError when the mesh cannot be loaded.
 EvalModel EvalModelFromRecord(const ModelRecord& record, size_t max_points = 4000);
+
+/// EvalModelFromRecord of every model of `library`, in its order.
+std::vector<EvalModel> EvalModels(const ModelLibrary& library);
 
 /// The outcome for one ground-truth object of a frame.
 struct ObjectEvaluation {

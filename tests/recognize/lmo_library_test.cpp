@@ -36,9 +36,7 @@ TEST(LmoLibrary, FindsTheCanAndTheDuckWithoutFalsePositives) {
 
   LibraryLoadOptions load;
   load.build_matchers = false;
-  const ModelLibrary loaded = ModelLibrary::Load(library, load);
-  std::vector<EvalModel> eval_models;
-  for (const LibraryModel& model : loaded.models()) eval_models.push_back(EvalModelFromRecord(model.record));
+  const std::vector<EvalModel> eval_models = EvalModels(ModelLibrary::Load(library, load));
   std::ifstream in(out);
   const nlohmann::json detections = nlohmann::json::parse(in);
   const LoadedFrame frame = LoadBopFrame(scene, 3, depth);

@@ -65,8 +65,7 @@ TEST_F(RecognizeEndToEnd, FindsTheObjectsOfTheDemoFrameWithinTenthOfTheirDiamete
 
   const LoadedFrame frame = LoadYcbvFrame(Frame());
   const ModelLibrary library = Library();
-  std::vector<EvalModel> models;
-  for (const LibraryModel& model : library.models()) models.push_back(EvalModelFromRecord(model.record));
+  const std::vector<EvalModel> models = EvalModels(library);
   const std::vector<Detection> detections = DetectionsFromJson(ReadJsonFile(json), json);
   for (const Detection& detection : detections) {
     EXPECT_GT(detection.score, 0.0);
@@ -226,8 +225,7 @@ TEST_F(RecognizeEndToEnd, FindsBothOfTwoMustardBottlesWhenAskedForTwoInstances) 
   const std::string frame = directory_->File("two_bottles.json");
   WriteFrameJson(frame, scene.rgbd);
   const ModelLibrary library = Library();
-  std::vector<EvalModel> models;
-  for (const LibraryModel& model : library.models()) models.push_back(EvalModelFromRecord(model.record));
+  const std::vector<EvalModel> models = EvalModels(library);
   auto bottles = [&](const std::string& flags, FrameEvaluation* evaluation) {
     const std::string json = directory_->File("two_bottles_detections.json");
     const test::CommandResult run =

@@ -77,8 +77,7 @@ TEST_F(YcbvLibrary, FindsTexturedObjectsOnThreeVideosWithoutFalsePositives) {
   load.build_matchers = false;
   const ModelLibrary library = ModelLibrary::Load(library_, load);
   ASSERT_EQ(library.models().size(), 7U);
-  std::vector<EvalModel> models;
-  for (const LibraryModel& model : library.models()) models.push_back(EvalModelFromRecord(model.record));
+  const std::vector<EvalModel> models = EvalModels(library);
 
   int present = 0, correct = 0, false_positives = 0;
   std::string report;
@@ -121,8 +120,7 @@ TEST_F(YcbvLibrary, TracksTheThreeObjectsOfVideo0001FromFrameToFrame) {
   LibraryLoadOptions load;
   load.build_matchers = false;
   const ModelLibrary library = ModelLibrary::Load(library_, load);
-  std::vector<EvalModel> models;
-  for (const LibraryModel& model : library.models()) models.push_back(EvalModelFromRecord(model.record));
+  const std::vector<EvalModel> models = EvalModels(library);
   for (size_t i = 0; i < frames.size(); ++i) {
     const FrameEvaluation evaluation = EvaluateFrame(frames[i], DetectionsFromJson(lines[i], frames[i]),
                                                      LoadYcbvFrame(frames[i]).ground_truth, models);
