@@ -259,20 +259,20 @@ class Recognizer::Impl {
     const Clock::time_point start = Clock::now();
     RecognitionResult result;
     Scene scene = PrepareScene(frame);
-    std::vector<Verified> candidates;
     // Per model: the instances found so far (tracked, then recognised) and the scene pixels their surfaces cover.
-    std::vector<int> instances(library_.models().size(), 0);
-    std::vector<cv::Mat> covered(library_.models().size());
+    const size_t models = library_.models().size();
+    std::vector<std::vector<Verified>> found(models);
+    std::vector<cv::Mat> covered(models);
     auto add_instance = [&](size_t m, Verified verified) {
       if (covered[m].empty()) covered[m] = cv::Mat::zeros(frame.depth.size(), CV_8UC1);
       CoverSurface(verified.surface, options_.dense_stride_px, &covered[m]);
-      ++instances[m];
-      candidates.push_back(std::move(verified));
+      found[m].push_back(std::move(verified));
     };
+    auto instances = [&](size_t m) { return static_cast<int>(found[m].size()); };
     Clock::time_point stage = Clock::now();
     for (const Detection& prior : priors) {
       const std::optional<size_t> m = ModelIndex(prior.model);
-      if (!m || instances[*m] >= options_.max_instances ||
+      if (!m || instances(*m) >= options_.max_instances ||
           (!prior.tracked && prior.score < options_.min_track_start_score)) {
         continue;
       }
@@ -280,21 +280,30 @@ class Recognizer::Impl {
       if (Accepted(tracked.detection)) add_instance(*m, std::move(tracked));
     }
     if (!priors.empty()) result.timings_ms["track"] = MillisecondsSince(stage);
-    std::vector<bool> done(library_.models().size());
-    for (size_t m = 0; m < done.size(); ++m) done[m] = instances[m] >= options_.max_instances;
+    std::vector<bool> done(models);
+    for (size_t m = 0; m < models; ++m) done[m] = instances(m) >= options_.max_instances;
     if (std::count(done.begin(), done.end(), false) > 0) DescribeScene(&scene, &result);  // none when all tracked
-    stage = Clock::now();
-    std::vector<std::vector<ViewCandidate>> ranked = RankAllViews(scene, done);
-    result.timings_ms["match"] += MillisecondsSince(stage);
-    for (size_t m = 0; m < library_.models().size(); ++m) {
-      while (instances[m] < options_.max_instances) {
+    // The models on RansacOptions::threads workers, each RANSAC on one thread: a model's search depends on nothing
+    // of the others', so the detections do not depend on the count. Stage times are summed over the workers.
+    std::vector<std::map<std::string, double>> model_timings(models);
+    ParallelFor(models, options_.ransac.threads, [&](size_t m) {
+      if (done[m]) return;
+      const Clock::time_point ranking = Clock::now();
+      std::vector<ViewCandidate> ranked = RankViews(m, scene);
+      model_timings[m]["match"] += MillisecondsSince(ranking);
+      while (instances(m) < options_.max_instances) {
         // Once an instance is found the model is known to be in the frame: more of its views are worth trying.
-        const int views = instances[m] == 0 || options_.later_instance_views == 0 ? options_.views_per_model
+        const int views = instances(m) == 0 || options_.later_instance_views == 0 ? options_.views_per_model
                                                                                   : options_.later_instance_views;
-        std::optional<Verified> best = BestDetection(m, views, scene, covered[m], &ranked[m], &result.timings_ms);
+        std::optional<Verified> best = BestDetection(m, views, scene, covered[m], &ranked, &model_timings[m]);
         if (!best || !Accepted(best->detection)) break;
         add_instance(m, std::move(*best));
       }
+    });
+    std::vector<Verified> candidates;
+    for (size_t m = 0; m < models; ++m) {
+      for (auto& [name, ms] : model_timings[m]) result.timings_ms[name] += ms;
+      for (Verified& verified : found[m]) candidates.push_back(std::move(verified));
     }
     stage = Clock::now();
     result.detections = SuppressOverlaps(frame.depth.size(), std::move(candidates));
@@ -415,16 +424,6 @@ class Recognizer::Impl {
     return best;
   }
 
-  // RankViews of every model but the skipped ones, the models shared out over RansacOptions::threads workers (each
-  // model's ranking depends on nothing else, so the result does not depend on the count).
-  std::vector<std::vector<ViewCandidate>> RankAllViews(const Scene& scene, const std::vector<bool>& skip) const {
-    std::vector<std::vector<ViewCandidate>> ranked(records_.size());
-    ParallelFor(records_.size(), options_.ransac.threads, [&](size_t m) {
-      if (!skip[m]) ranked[m] = RankViews(m, scene);
-    });
-    return ranked;
-  }
-
   // The model's views, best ranked first; the best views_per_model with all their correspondences (Match).
   std::vector<ViewCandidate> RankViews(size_t model, const Scene& scene) const {
     std::vector<ViewCandidate> views = ScoreViews(model, scene);
@@ -502,6 +501,7 @@ class Recognizer::Impl {
     stage = Clock::now();
     const ModelRecord& record = records_[model];
     RansacOptions ransac = options_.ransac;
+    ransac.threads = 1;  // the models share the workers out (Recognize)
     ransac.sample_radius_m = options_.sample_radius_diameters * record.diameter_m;
     Hypothesis hypothesis;
     hypothesis.view = candidate->view;
@@ -579,7 +579,11 @@ class Recognizer::Impl {
     const RgbdFrame& frame = *scene.frame;
     const int stride = options_.dense_stride_px;
     const PinholeCamera camera = frame.camera.Sampled(stride);
-    const RenderResult rendered = renderer_.Render(meshes_[model], camera, hypothesis.pose, render_options_[model]);
+    RenderResult rendered;
+    {
+      const std::lock_guard<std::mutex> lock(render_mutex_);  // one GL context: one render at a time
+      rendered = renderer_.Render(meshes_[model], camera, hypothesis.pose, render_options_[model]);
+    }
     cv::Mat model_color;
     if (options_.color_blur_px > 0.0) {
       cv::GaussianBlur(rendered.color, model_color, cv::Size(0, 0), options_.color_blur_px / stride);
@@ -739,6 +743,7 @@ class Recognizer::Impl {
   RecognizerOptions options_;
   std::vector<ModelRecord> records_;  // per model: the library's, colours mapped by its colour matrix if any
   Renderer renderer_;
+  std::mutex render_mutex_;  // Verify runs on the model workers
   std::vector<MeshId> meshes_;
   std::vector<RenderOptions> render_options_;  // per model: shaded as its library views are
 };
