@@ -222,7 +222,8 @@ CommandAction SetupRecognizeCommand(CLI::App& command) {
   command.add_option("--seed", options.ransac.seed, "Random seed")->capture_default_str();
   command
       .add_option("--threads", options.ransac.threads,
-                  "Worker threads for describing the scene and searching the models, one model each (same result for any count)")
+                  "Worker threads for describing the scene and searching the models, one model each (same result for "
+                  "any count)")
       ->capture_default_str();
   command.add_flag(
       "--no-icp", [&options = args->options](int64_t) { options.refine = false; }, "Skip the ICP refinement");
