@@ -283,8 +283,11 @@ class Recognizer::Impl {
     std::vector<bool> done(models);
     for (size_t m = 0; m < models; ++m) done[m] = instances(m) >= options_.max_instances;
     if (std::count(done.begin(), done.end(), false) > 0) DescribeScene(&scene, &result);  // none when all tracked
-    // The models on RansacOptions::threads workers, each RANSAC on one thread: a model's search depends on nothing
+    // The models on RansacOptions::threads workers: a model's search depends on nothing
     // of the others', so the detections do not depend on the count. Stage times are summed over the workers.
+    // Fewer models to search than workers (a one-model library, say): the spare ones share each RANSAC's blocks.
+    const auto searched = static_cast<int>(std::count(done.begin(), done.end(), false));
+    ransac_threads_ = std::max(1, options_.ransac.threads / std::max(1, searched));
     std::vector<std::map<std::string, double>> model_timings(models);
     ParallelFor(models, options_.ransac.threads, [&](size_t m) {
       if (done[m]) return;
@@ -501,7 +504,7 @@ class Recognizer::Impl {
     stage = Clock::now();
     const ModelRecord& record = records_[model];
     RansacOptions ransac = options_.ransac;
-    ransac.threads = 1;  // the models share the workers out (Recognize)
+    ransac.threads = ransac_threads_;  // the models share the workers out (Recognize)
     ransac.sample_radius_m = options_.sample_radius_diameters * record.diameter_m;
     Hypothesis hypothesis;
     hypothesis.view = candidate->view;
@@ -744,6 +747,7 @@ class Recognizer::Impl {
   std::vector<ModelRecord> records_;  // per model: the library's, colours mapped by its colour matrix if any
   Renderer renderer_;
   std::mutex render_mutex_;  // Verify runs on the model workers
+  int ransac_threads_ = 1;   // per RANSAC, set by Recognize for the frame
   std::vector<MeshId> meshes_;
   std::vector<RenderOptions> render_options_;  // per model: shaded as its library views are
 };

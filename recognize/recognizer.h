@@ -25,7 +25,8 @@ struct RecognizerOptions {
   MatchOptions match = DefaultMatch();
   /// RANSAC per model view; the paper's test (t_poly 0.25, eps 1 cm, 50 % of the visible object points).
   /// Its `threads` are the Recognizer's workers: they describe the scene and then take a model each (ranking,
-  /// RANSAC on one thread, verification, ICP; renders one at a time). The detections do not depend on the count.
+  /// RANSAC, verification, ICP; renders one at a time; a RANSAC gets more than one thread only when there are
+  /// fewer models to search than workers). The detections do not depend on the count.
   RansacOptions ransac = DefaultRansac();
   /// Views per model tried with RANSAC, the best ranked first. On the 30 YCB-Video frames, RANSAC seeds 1/2/3:
   /// 7 views found 49/47/46 of 70 objects and 5 views 47/43/44 (both with ransac_stride_px 4 and approximate
