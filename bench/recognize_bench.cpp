@@ -6,9 +6,11 @@
 //
 //   scripts/build_ycbv_library /tmp/ycbv.sqlite --views 40 --distance 0.9
 //   scripts/build_lmo_library /tmp/lmo.sqlite --views 40 --distance 1.0
-//   recognize_bench --db /tmp/ycbv.sqlite [--lmo-db /tmp/lmo.sqlite] [--peers] [--track] [--threads N]
-//                   [--results bench/RESULTS.md] [--frames N]
+//   recognize_bench --db /tmp/ycbv.sqlite [--lmo-db /tmp/lmo.sqlite] [--peers] [--track] [--search-every N]
+//                   [--threads N] [--results bench/RESULTS.md] [--frames N]
 // --threads N (N > 1) adds a run of ours with N worker threads: the same detections (checked), its own times.
+// --track adds a run with the previous frame's detections as priors; --search-every N (N > 1) one more where
+// only every N-th frame of a video searches the models that are not tracked (recognize --search-every).
 // --object-pixels also runs the peers on depth cut to the ground-truth objects' own pixels; --peers-only,
 // --frame-step, --ppf-sampling, --ppf-scene-distance and --min-inlier-fraction are for tuning the peers.
 
@@ -82,17 +84,24 @@ bool SameDetections(const Run& a, const Run& b) {
   return true;
 }
 
-// With `track`, each frame gets the previous frame's detections of the same video as priors.
+// With `track`, each frame gets the previous frame's detections of the same video as priors, and only every
+// `search_every`-th frame of a video (the first, 1 + n, ...) searches the models that are not tracked.
 Run RunRecognizer(const ModelLibrary& library, const RecognizerOptions& options, const std::vector<NamedFrame>& frames,
-                  const std::vector<EvalModel>& models, const std::string& label, bool track = false) {
+                  const std::vector<EvalModel>& models, const std::string& label, bool track = false,
+                  int search_every = 1) {
   Recognizer recognizer(library, options);
   Run run;
   std::vector<Detection> previous;
+  int in_video = 0;  // frames of the video before this one
   for (size_t i = 0; i < frames.size(); ++i) {
     const auto video = [&](size_t k) { return frames[k].name.substr(0, frames[k].name.find('/')); };
-    if (i > 0 && video(i) != video(i - 1)) previous.clear();
-    const RecognitionResult result =
-        track ? recognizer.Recognize(frames[i].frame.rgbd, previous) : recognizer.Recognize(frames[i].frame.rgbd);
+    if (i > 0 && video(i) != video(i - 1)) {
+      previous.clear();
+      in_video = 0;
+    }
+    const SearchScope scope = in_video++ % search_every == 0 ? SearchScope::kAllModels : SearchScope::kLostTracks;
+    const RecognitionResult result = track ? recognizer.Recognize(frames[i].frame.rgbd, previous, scope)
+                                           : recognizer.Recognize(frames[i].frame.rgbd);
     previous = result.detections;
     run.frames.push_back(EvaluateFrame(frames[i].name, result.detections, frames[i].frame.ground_truth, models));
     for (const auto& [stage, ms] : result.timings_ms) run.stage_ms[stage].push_back(ms);
@@ -252,6 +261,11 @@ const char* kTracking = "ECV + RANSAC + ICP, tracking";
 const char* kPcl = "PCL FPFH + prerejective + ICP";
 const char* kPpf = "OpenCV PPF + ICP";
 
+// The label of tracking with a full search every `n`-th frame.
+std::string TrackingEvery(int n) {
+  return std::string(kTracking) + ", full search every " + std::to_string(n) + " frames";
+}
+
 // The run labelled `name` (it must be there).
 const Run& RunNamed(const Runs& runs, const std::string& name) {
   return std::find_if(runs.begin(), runs.end(), [&](const auto& run) { return run.first == name; })->second;
@@ -261,6 +275,7 @@ const Run& RunNamed(const Runs& runs, const std::string& name) {
 struct Methods {
   bool ours = true;            ///< ECV with and without ICP
   bool track = false;          ///< ours also with the previous frame's detections as priors
+  int search_every = 1;        ///< > 1: ours also tracking with a full search only every n-th frame
   bool peers = false;          ///< PCL and OpenCV PPF on the whole frames
   bool object_pixels = false;  ///< the peers also on the objects' pixels only
   int threads = 1;             ///< > 1: ours also with this many worker threads (the same detections, faster)
@@ -292,6 +307,10 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
     }
     if (methods.track) {
       runs.emplace_back(kTracking, RunRecognizer(library, options, frames, models, "track", true));
+      if (methods.search_every > 1) {
+        runs.emplace_back(TrackingEvery(methods.search_every),
+                          RunRecognizer(library, options, frames, models, "track every", true, methods.search_every));
+      }
     }
     options.refine = false;
     runs.emplace_back("ECV + RANSAC (no ICP)", RunRecognizer(library, options, frames, models, "no icp"));
@@ -379,6 +398,13 @@ int main(int argc, char** argv) {
       }
     } else if (std::strcmp(argv[i], "--track") == 0) {
       methods.track = true;
+    } else if (has_value && std::strcmp(argv[i], "--search-every") == 0) {
+      methods.track = true;
+      methods.search_every = std::atoi(argv[++i]);
+      if (methods.search_every < 1) {
+        db.clear();
+        break;
+      }
     } else if (has_value && std::strcmp(argv[i], "--frame-step") == 0) {
       step = std::atoi(argv[++i]);
     } else if (has_value && std::strcmp(argv[i], "--ppf-sampling") == 0) {
@@ -403,7 +429,7 @@ int main(int argc, char** argv) {
   if (db.empty()) {
     std::cerr
         << "usage: recognize_bench --db LIB.sqlite [--lmo-db LMO.sqlite] [--peers | --peers-only] [--object-pixels]\n"
-           "         [--track] [--threads N]\n"
+           "         [--track] [--search-every N] [--threads N]\n"
            "         [--results FILE] [--frames N] [--frame-step S] [--ppf-sampling R] [--ppf-scene-distance R]\n"
            "         [--min-inlier-fraction F]\n"
            "  (build the libraries with scripts/build_ycbv_library LIB.sqlite --views 40 --distance 0.9 and\n"
@@ -425,6 +451,14 @@ int main(int argc, char** argv) {
       markdown << "\nThe same with tracking (each frame gets the previous frame's detections of its video as priors; "
                   "the first frame of each video has none):\n\n"
                << TimingTable(RunNamed(runs, kTracking));
+      if (methods.search_every > 1) {
+        markdown << "\nTracking with a full search on the first frame of each video and every "
+                 << methods.search_every
+                 << "th after it only; the frames in between follow the tracked objects and search only the models whose "
+                    "track was lost (`recognize --track --search-every "
+                 << methods.search_every << "`):\n\n"
+                 << TimingTable(RunNamed(runs, TrackingEvery(methods.search_every)));
+      }
     }
     if (!lmo_db.empty()) {
       std::ostringstream lmo_notes;

@@ -32,6 +32,7 @@ struct RecognizeArgs {
   int scene_id = -1, image_id = -1;
   std::string overlay;
   bool track = false;
+  int search_every = 1;  // with track: models without a prior are searched on every n-th frame only
 };
 
 // BOP object id of a model: the number in "obj_000005", or the YCB-Video class index of "003_cracker_box".
@@ -110,6 +111,8 @@ int RunRecognize(const RecognizeArgs& args) {
     ThrowInputError("recognize", "--sequence", "either a sequence or one frame, not both");
   }
   if (args.track && args.sequence.empty()) ThrowInputError("recognize", "--track", "a --sequence to track along");
+  if (args.search_every < 1) ThrowInputError("recognize", "--search-every", "at least 1");
+  if (args.search_every > 1 && !args.track) ThrowInputError("recognize", "--search-every", "--track as well");
   std::vector<std::string> frames;
   if (!args.sequence.empty()) frames = ListSequenceFrames(args.sequence);
   LibraryLoadOptions load;
@@ -151,8 +154,10 @@ int RunRecognize(const RecognizeArgs& args) {
     try {
       const LoadedFrame loaded = app::LoadFrameWithWarnings(spec);
       const std::pair<int, int> ids = args.out_bop.empty() ? std::pair{-1, -1} : BopIds(frames[i], -1, -1);
+      const SearchScope scope = i % static_cast<size_t>(args.search_every) == 0 ? SearchScope::kAllModels
+                                                                                : SearchScope::kLostTracks;
       const RecognitionResult result =
-          args.track ? recognizer.Recognize(loaded.rgbd, previous) : recognizer.Recognize(loaded.rgbd);
+          args.track ? recognizer.Recognize(loaded.rgbd, previous, scope) : recognizer.Recognize(loaded.rgbd);
       previous = result.detections;
       total_ms += result.timings_ms.at("total");
       std::cout << "[" << i + 1 << "/" << frames.size() << "] ";
@@ -230,6 +235,11 @@ CommandAction SetupRecognizeCommand(CLI::App& command) {
   command.add_flag("--track", args->track,
                    "With --sequence: try each object first at its pose in the previous frame (refined and verified);\n"
                    "objects tracked so skip view ranking and RANSAC");
+  command
+      .add_option("--search-every", args->search_every,
+                  "With --track: models not tracked are searched on every N-th frame only (the first, 1 + N, ...);\n"
+                  "in between, the tracked objects are followed and a lost one is searched for at once")
+      ->capture_default_str();
   command
       .add_option("--track-start-score", options.min_track_start_score,
                   "With --track: a new detection is followed into the next frame only from this score on")

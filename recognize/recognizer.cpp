@@ -254,7 +254,7 @@ class Recognizer::Impl {
     return ranked;
   }
 
-  RecognitionResult Recognize(const RgbdFrame& frame, const std::vector<Detection>& priors) {
+  RecognitionResult Recognize(const RgbdFrame& frame, const std::vector<Detection>& priors, SearchScope scope) {
     frame.Check();
     const Clock::time_point start = Clock::now();
     RecognitionResult result;
@@ -269,19 +269,37 @@ class Recognizer::Impl {
       found[m].push_back(std::move(verified));
     };
     auto instances = [&](size_t m) { return static_cast<int>(found[m].size()); };
-    Clock::time_point stage = Clock::now();
+    // The priors to follow, a model's in their order, the models on the workers (as the search below). A model
+    // whose prior fails, or is a first detection below min_track_start_score, is `lost`: it was seen, so even a
+    // frame that searches only for lost tracks searches for it.
+    std::vector<std::vector<const Detection*>> model_priors(models);
+    std::vector<char> lost(models, 0);  // not vector<bool>: written by the workers
     for (const Detection& prior : priors) {
       const std::optional<size_t> m = ModelIndex(prior.model);
-      if (!m || instances(*m) >= options_.max_instances ||
-          (!prior.tracked && prior.score < options_.min_track_start_score)) {
-        continue;
+      if (!m) continue;
+      if (prior.tracked || prior.score >= options_.min_track_start_score) {
+        model_priors[*m].push_back(&prior);
+      } else {
+        lost[*m] = 1;
       }
-      Verified tracked = Track(*m, prior, scene);
-      if (Accepted(tracked.detection)) add_instance(*m, std::move(tracked));
     }
+    Clock::time_point stage = Clock::now();
+    ParallelFor(models, options_.ransac.threads, [&](size_t m) {
+      for (const Detection* prior : model_priors[m]) {
+        if (instances(m) >= options_.max_instances) break;
+        Verified tracked = Track(m, *prior, scene);
+        if (Accepted(tracked.detection)) {
+          add_instance(m, std::move(tracked));
+        } else {
+          lost[m] = 1;
+        }
+      }
+    });
     if (!priors.empty()) result.timings_ms["track"] = MillisecondsSince(stage);
     std::vector<bool> done(models);
-    for (size_t m = 0; m < models; ++m) done[m] = instances(m) >= options_.max_instances;
+    for (size_t m = 0; m < models; ++m) {
+      done[m] = instances(m) >= options_.max_instances || (scope == SearchScope::kLostTracks && lost[m] == 0);
+    }
     if (std::count(done.begin(), done.end(), false) > 0) DescribeScene(&scene, &result);  // none when all tracked
     // The models on RansacOptions::threads workers: a model's search depends on nothing
     // of the others', so the detections do not depend on the count. Stage times are summed over the workers.
@@ -758,11 +776,12 @@ Recognizer::Recognizer(const ModelLibrary& library, const RecognizerOptions& opt
 Recognizer::~Recognizer() = default;
 
 RecognitionResult Recognizer::Recognize(const RgbdFrame& frame) {
-  return impl_->Recognize(frame, {});
+  return impl_->Recognize(frame, {}, SearchScope::kAllModels);
 }
 
-RecognitionResult Recognizer::Recognize(const RgbdFrame& frame, const std::vector<Detection>& priors) {
-  return impl_->Recognize(frame, priors);
+RecognitionResult Recognizer::Recognize(const RgbdFrame& frame, const std::vector<Detection>& priors,
+                                        SearchScope scope) {
+  return impl_->Recognize(frame, priors, scope);
 }
 
 std::map<std::string, std::vector<RankedView>> Recognizer::RankViews(const RgbdFrame& frame) {

@@ -191,6 +191,17 @@ nlohmann::json RecognitionToJson(const RecognitionResult& result);
 /// field when one is missing or malformed.
 std::vector<Detection> DetectionsFromJson(const nlohmann::json& json, const std::string& source);
 
+/// What a tracking frame (Recognizer::Recognize with priors) searches for, by view ranking and RANSAC, besides
+/// following its priors.
+enum class SearchScope {
+  kAllModels,  ///< every model whose prior fails or that has none: a full detection frame
+  /// Only the models whose prior failed or fell below RecognizerOptions::min_track_start_score (a lost track is
+  /// looked for at once); models without a prior are not looked for. When every prior passes, the frame's primitives are not even extracted. A stream alternates
+  /// it with full frames (`recognize --track --search-every N`) to follow known objects at a fraction of the
+  /// cost and still pick up new ones every N frames.
+  kLostTracks,
+};
+
 /// Finds the library's models in RGB-D frames. Owns an offscreen renderer (for verification) with the
 /// models' meshes, loaded from the paths stored in the library. One Recognizer per thread.
 class Recognizer {
@@ -204,8 +215,9 @@ class Recognizer {
 
   /// Tracking, for frames of a stream (beyond the paper): each prior (a detection of the previous frame) is
   /// first tried at its pose, refined by ICP and verified as any detection; when it passes, its model skips
-  /// view ranking and RANSAC in this frame. Models without a prior, or whose prior fails, are recognised.
-  RecognitionResult Recognize(const RgbdFrame& frame, const std::vector<Detection>& priors);
+  /// view ranking and RANSAC in this frame. Which of the other models are searched: see SearchScope.
+  RecognitionResult Recognize(const RgbdFrame& frame, const std::vector<Detection>& priors,
+                              SearchScope scope = SearchScope::kAllModels);
 
   /// View ranking alone, for studying it: every model's views as Recognize ranks them in `frame`, best first
   /// (RANSAC tries the first views_per_model of them).

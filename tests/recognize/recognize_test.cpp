@@ -182,6 +182,45 @@ TEST_F(RecognizeEndToEnd, AFirstDetectionBelowTheTrackStartScoreIsNotFollowed) {
   EXPECT_EQ(kept.scene_primitives, 0);
 }
 
+// A tracking frame that searches only for lost tracks (SearchScope::kLostTracks, `recognize --search-every`):
+// the cracker box follows its prior; the mustard bottle's prior lies 30 cm off, fails, and the bottle is
+// searched for at once; the sugar box has no prior and is not looked for until a full frame.
+TEST_F(RecognizeEndToEnd, ALostTrackIsSearchedForAtOnceAndAModelWithoutAPriorOnlyInAFullFrame) {
+  const ModelLibrary library = Library();
+  const LoadedFrame frame = LoadYcbvFrame(Frame());
+  Recognizer recognizer(library);
+  const RecognitionResult found = recognizer.Recognize(frame.rgbd);
+  ASSERT_EQ(found.detections.size(), 3U);
+  std::vector<Detection> priors;
+  for (Detection prior : found.detections) {
+    if (prior.model == "004_sugar_box") continue;
+    prior.tracked = true;
+    if (prior.model == "006_mustard_bottle") prior.camera_from_object.translation().x() += 0.3;
+    priors.push_back(prior);
+  }
+
+  const RecognitionResult lost = recognizer.Recognize(frame.rgbd, priors, SearchScope::kLostTracks);
+  EXPECT_GT(lost.scene_primitives, 0);  // the bottle was searched for
+  std::map<std::string, Detection> by_model;
+  for (const Detection& detection : lost.detections) by_model[detection.model] = detection;
+  ASSERT_EQ(by_model.size(), 2U);
+  ASSERT_EQ(by_model.count("003_cracker_box"), 1U);
+  ASSERT_EQ(by_model.count("006_mustard_bottle"), 1U);
+  EXPECT_TRUE(by_model["003_cracker_box"].tracked);
+  const Detection& bottle = by_model["006_mustard_bottle"];
+  EXPECT_FALSE(bottle.tracked);
+  const GroundTruth* truth = TruthOf(frame, bottle.model);
+  ASSERT_NE(truth, nullptr);
+  EXPECT_LT(TranslationDistance(bottle.camera_from_object, truth->camera_from_object), 0.01);
+  EXPECT_LT(RotationAngle(bottle.camera_from_object, truth->camera_from_object), 8.0 * M_PI / 180.0);
+
+  const RecognitionResult full = recognizer.Recognize(frame.rgbd, priors, SearchScope::kAllModels);
+  ASSERT_EQ(full.detections.size(), 3U);
+  EXPECT_EQ(std::count_if(full.detections.begin(), full.detections.end(),
+                          [](const Detection& detection) { return detection.model == "004_sugar_box"; }),
+            1);
+}
+
 // Verification's surface-fit factor: the cracker box at its ground-truth pose fits the depth to the sensor's noise;
 // moved 9 mm back along its line of sight it still lies within the 1.5 cm depth tolerance almost everywhere,
 // but its mean residual (about 9 mm) is past residual_free_m + residual_falloff_m, so it scores 0.
@@ -260,6 +299,12 @@ TEST_F(RecognizeEndToEnd, BadInputIsReported) {
   EXPECT_NE(missing_frame.output.find("/nonexistent/000001"), std::string::npos) << missing_frame.output;
   const test::CommandResult no_db = test::RunCli("recognize " + Frame());
   EXPECT_EQ(no_db.exit_code, 2) << no_db.output;
+  const test::CommandResult untracked =
+      test::RunCli("recognize --db " + library_ + " --sequence " + std::string(ECV_SOURCE_DIR) +
+                   "/models/frame --search-every 3");
+  EXPECT_EQ(untracked.exit_code, 1) << untracked.output;
+  EXPECT_NE(untracked.output.find("--search-every"), std::string::npos) << untracked.output;
+  EXPECT_NE(untracked.output.find("--track"), std::string::npos) << untracked.output;
 }
 
 // The meshes are read again when a Recognizer is made (for verification renders), on worker threads: a mesh file

@@ -134,6 +134,27 @@ TEST_F(YcbvLibrary, TracksTheThreeObjectsOfVideo0001FromFrameToFrame) {
   }
 }
 
+// `--search-every 4`: frame 1 searches every model; frames 2-4 follow the three objects and, all of them
+// holding, search nothing (no primitives extracted), with the same three objects found.
+TEST_F(YcbvLibrary, BetweenFullSearchesOnlyTheTracksAreFollowed) {
+  const std::string scenes = test::DataPath("ycbv_subset/Example-Scenes/0001/");
+  const std::vector<std::string> frames = {scenes + "000001", scenes + "000003", scenes + "000005", scenes + "000007"};
+  const std::vector<nlohmann::json> lines = Recognize("search_every", "--track --search-every 4", frames);
+  ASSERT_EQ(lines.size(), frames.size());
+  LibraryLoadOptions load;
+  load.build_matchers = false;
+  const std::vector<EvalModel> models = EvalModels(ModelLibrary::Load(library_, load));
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const FrameEvaluation evaluation = EvaluateFrame(frames[i], DetectionsFromJson(lines[i], frames[i]),
+                                                     LoadYcbvFrame(frames[i]).ground_truth, models);
+    for (const ObjectEvaluation& object : evaluation.objects) EXPECT_TRUE(object.correct) << frames[i] << object.model;
+    EXPECT_EQ(evaluation.false_positives, 0) << frames[i];
+    const nlohmann::json& timings = lines[i].at("timings_ms");
+    EXPECT_EQ(timings.contains("extract"), i == 0) << frames[i] << timings.dump();
+    EXPECT_EQ(timings.contains("ransac"), i == 0) << frames[i] << timings.dump();
+  }
+}
+
 TEST_F(YcbvLibrary, BrokenFrameInSequenceIsReportedAndTheOthersAreProcessed) {
   const std::string list = directory_->File("broken.txt"), out = directory_->File("broken.jsonl");
   const std::string missing = directory_->File("no_such_video/000001");
