@@ -154,8 +154,8 @@ int RunRecognize(const RecognizeArgs& args) {
     try {
       const LoadedFrame loaded = app::LoadFrameWithWarnings(spec);
       const std::pair<int, int> ids = args.out_bop.empty() ? std::pair{-1, -1} : BopIds(frames[i], -1, -1);
-      const SearchScope scope = i % static_cast<size_t>(args.search_every) == 0 ? SearchScope::kAllModels
-                                                                                : SearchScope::kLostTracks;
+      const SearchScope scope =
+          i % static_cast<size_t>(args.search_every) == 0 ? SearchScope::kAllModels : SearchScope::kLostTracks;
       const RecognitionResult result =
           args.track ? recognizer.Recognize(loaded.rgbd, previous, scope) : recognizer.Recognize(loaded.rgbd);
       previous = result.detections;

@@ -196,9 +196,9 @@ std::vector<Detection> DetectionsFromJson(const nlohmann::json& json, const std:
 enum class SearchScope {
   kAllModels,  ///< every model whose prior fails or that has none: a full detection frame
   /// Only the models whose prior failed or fell below RecognizerOptions::min_track_start_score (a lost track is
-  /// looked for at once); models without a prior are not looked for. When every prior passes, the frame's primitives are not even extracted. A stream alternates
-  /// it with full frames (`recognize --track --search-every N`) to follow known objects at a fraction of the
-  /// cost and still pick up new ones every N frames.
+  /// looked for at once); models without a prior are not looked for. When every prior passes, the frame's primitives
+  /// are not even extracted. A stream alternates it with full frames (`recognize --track --search-every N`) to follow
+  /// known objects at a fraction of the cost and still pick up new ones every N frames.
   kLostTracks,
 };
 

@@ -299,9 +299,8 @@ TEST_F(RecognizeEndToEnd, BadInputIsReported) {
   EXPECT_NE(missing_frame.output.find("/nonexistent/000001"), std::string::npos) << missing_frame.output;
   const test::CommandResult no_db = test::RunCli("recognize " + Frame());
   EXPECT_EQ(no_db.exit_code, 2) << no_db.output;
-  const test::CommandResult untracked =
-      test::RunCli("recognize --db " + library_ + " --sequence " + std::string(ECV_SOURCE_DIR) +
-                   "/models/frame --search-every 3");
+  const test::CommandResult untracked = test::RunCli("recognize --db " + library_ + " --sequence " +
+                                                     std::string(ECV_SOURCE_DIR) + "/models/frame --search-every 3");
   EXPECT_EQ(untracked.exit_code, 1) << untracked.output;
   EXPECT_NE(untracked.output.find("--search-every"), std::string::npos) << untracked.output;
   EXPECT_NE(untracked.output.find("--track"), std::string::npos) << untracked.output;
