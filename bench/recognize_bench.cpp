@@ -452,12 +452,12 @@ int main(int argc, char** argv) {
                   "the first frame of each video has none):\n\n"
                << TimingTable(RunNamed(runs, kTracking));
       if (methods.search_every > 1) {
-        markdown
-            << "\nTracking with a full search on the first frame of each video and every " << methods.search_every
-            << "th after it only; the frames in between follow the tracked objects and search only the models whose "
-               "track was lost (`recognize --track --search-every "
-            << methods.search_every << "`):\n\n"
-            << TimingTable(RunNamed(runs, TrackingEvery(methods.search_every)));
+        markdown << "\nTracking with a full search only on the first frame of each video and then once every "
+                 << methods.search_every
+                 << " frames; the frames in between follow the tracked objects and search only the models whose "
+                    "track was lost (`recognize --track --search-every "
+                 << methods.search_every << "`):\n\n"
+                 << TimingTable(RunNamed(runs, TrackingEvery(methods.search_every)));
       }
     }
     if (!lmo_db.empty()) {
