@@ -310,7 +310,8 @@ class Recognizer::Impl {
     ParallelFor(models, options_.ransac.threads, [&](size_t m) {
       if (done[m]) return;
       const Clock::time_point ranking = Clock::now();
-      std::vector<ViewCandidate> ranked = RankViews(m, scene);
+      // A view's other descriptors are matched when it is tried (Try): views after a good enough one are not.
+      std::vector<ViewCandidate> ranked = ScoreViews(m, scene);
       model_timings[m]["match"] += MillisecondsSince(ranking);
       while (instances(m) < options_.max_instances) {
         // Once an instance is found the model is known to be in the frame: more of its views are worth trying.
@@ -443,15 +444,6 @@ class Recognizer::Impl {
     if (verified.detection.score >= best->detection.score) best = std::move(verified);
     (*timings_ms)["verify"] += MillisecondsSince(stage);
     return best;
-  }
-
-  // The model's views, best ranked first; the best views_per_model with all their correspondences (Match).
-  std::vector<ViewCandidate> RankViews(size_t model, const Scene& scene) const {
-    std::vector<ViewCandidate> views = ScoreViews(model, scene);
-    for (size_t i = 0; i < std::min(views.size(), static_cast<size_t>(options_.views_per_model)); ++i) {
-      Match(model, scene, &views[i]);
-    }
-    return views;
   }
 
   // The model's views, best ranked first, each with the correspondences of its ranking subset of descriptors.
