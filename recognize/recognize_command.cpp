@@ -147,6 +147,7 @@ int RunRecognize(const RecognizeArgs& args) {
   int failed = 0;
   double total_ms = 0.0;
   std::vector<Detection> previous;  // the last frame's detections, the priors when tracking
+  size_t full_search = 0;           // the next frame that searches every model (--search-every)
   if (!args.overlay.empty()) std::filesystem::create_directories(args.overlay);
   for (size_t i = 0; i < frames.size(); ++i) {
     FrameSpec spec;
@@ -154,8 +155,11 @@ int RunRecognize(const RecognizeArgs& args) {
     try {
       const LoadedFrame loaded = app::LoadFrameWithWarnings(spec);
       const std::pair<int, int> ids = args.out_bop.empty() ? std::pair{-1, -1} : BopIds(frames[i], -1, -1);
-      const SearchScope scope =
-          i % static_cast<size_t>(args.search_every) == 0 ? SearchScope::kAllModels : SearchScope::kLostTracks;
+      SearchScope scope = SearchScope::kLostTracks;
+      if (i >= full_search) {
+        scope = SearchScope::kAllModels;
+        full_search = i + static_cast<size_t>(args.search_every);
+      }
       const RecognitionResult result =
           args.track ? recognizer.Recognize(loaded.rgbd, previous, scope) : recognizer.Recognize(loaded.rgbd);
       previous = result.detections;
@@ -174,6 +178,7 @@ int RunRecognize(const RecognizeArgs& args) {
     } catch (const InputError& error) {
       ++failed;
       previous.clear();
+      full_search = i + 1;  // the priors are lost: the next frame searches every model
       std::cerr << "recognize: frame " << frames[i] << " skipped: " << error.what() << '\n';
       lines << nlohmann::json{{"frame", frames[i]}, {"error", error.what()}}.dump() << '\n';
     }
@@ -237,8 +242,9 @@ CommandAction SetupRecognizeCommand(CLI::App& command) {
                    "objects tracked so skip view ranking and RANSAC");
   command
       .add_option("--search-every", args->search_every,
-                  "With --track: models not tracked are searched on every N-th frame only (the first, 1 + N, ...);\n"
-                  "in between, the tracked objects are followed and a lost one is searched for at once")
+                  "With --track: models not tracked are searched on every N-th frame only (the first, 1 + N, ...;\n"
+                  "after a broken frame, the next); in between, the tracked objects are followed and a lost one is\n"
+                  "searched for at once")
       ->capture_default_str();
   command
       .add_option("--track-start-score", options.min_track_start_score,

@@ -175,5 +175,25 @@ TEST_F(YcbvLibrary, BrokenFrameInSequenceIsReportedAndTheOthersAreProcessed) {
   }
 }
 
+// With --search-every, the frame after a broken one searches every model: its priors were lost with it.
+TEST_F(YcbvLibrary, AfterABrokenFrameTheNextOneSearchesEveryModel) {
+  const std::string list = directory_->File("broken_every.txt"), out = directory_->File("broken_every.jsonl");
+  const std::string missing = directory_->File("no_such_video/000001");
+  std::ofstream(list) << Frames()[1] << '\n' << missing << '\n' << Frames()[1] << '\n' << Frames()[1] << '\n';
+  const test::CommandResult run = test::RunCli("recognize --db " + library_ + " --sequence " + list + " --out-json " +
+                                               out + " --track --search-every 10");
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  std::ifstream in(out);
+  std::vector<nlohmann::json> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(nlohmann::json::parse(line));
+  ASSERT_EQ(lines.size(), 4U);
+  EXPECT_TRUE(lines[1].contains("error"));
+  // Frames 1 and 3 search (the first; the one after the broken frame), frame 4 follows frame 3's three objects.
+  for (const size_t i : {0U, 2U, 3U}) {
+    EXPECT_EQ(lines[i].at("detections").size(), 3U) << i << lines[i].dump();
+    EXPECT_EQ(lines[i].at("timings_ms").contains("extract"), i != 3U) << i << lines[i].dump();
+  }
+}
+
 }  // namespace
 }  // namespace ecv
