@@ -253,35 +253,37 @@ Descriptors ComputeDescriptors(const std::vector<Primitive>& input, const Descri
   // The sources: every source_step-th primitive (all of them are neighbours).
   const size_t step = static_cast<size_t>(source_step);
   const size_t sources = (primitives.size() + step - 1) / step;
-  std::vector<float> source_positions(3 * sources);
-  for (size_t s = 0; s < sources; ++s) std::copy_n(&positions[3 * s * step], 3, &source_positions[3 * s]);
-  std::vector<std::vector<size_t>> neighbour_lists;  // per source
-  std::vector<std::vector<float>> distances;
-  index.radiusSearch(flann::Matrix<float>(source_positions.data(), sources, 3), neighbour_lists, distances,
-                     squared_radius, search);
 
   const AppearanceValues appearance = ComputeAppearance(primitives, options.appearance);
-  // Row s describes source s (primitive s * step); the rows of isolated sources are dropped at the end.
+  // Row s describes source s (primitive s * step); the rows of isolated sources are dropped at the end. The
+  // workers search each source's neighbours themselves: with the searches done up front on one thread, two
+  // workers took 44 instead of 49 ms for YCB-Video 0001/000001's 7439 primitives (4.5 cm shells); now 25 ms.
   cv::Mat values(static_cast<int>(sources), kDescriptorSize, CV_32F);
+  std::vector<char> described(sources, 0);  // not vector<bool>: written by the workers
   std::atomic<size_t> next{0};
   auto work = [&] {
     ContextHistograms histograms(appearance, options);  // per worker: reuses its buffers
+    std::vector<std::vector<size_t>> found(1);
+    std::vector<std::vector<float>> found_squared(1);
     std::vector<int> neighbours;
     std::vector<float> neighbour_distances;
     for (size_t s = next++; s < sources; s = next++) {
-      const std::vector<size_t>& found = neighbour_lists[s];  // by distance, the source first
-      if (found.size() < 2) continue;                         // isolated: no context
-      const size_t cap = options.max_neighbours > 0 ? static_cast<size_t>(options.max_neighbours) : found.size();
+      float* source = &positions[3 * s * step];
+      index.radiusSearch(flann::Matrix<float>(source, 1, 3), found, found_squared, squared_radius, search);
+      const std::vector<size_t>& near = found[0];  // by distance, the source first
+      if (near.size() < 2) continue;               // isolated: no context
+      const size_t cap = options.max_neighbours > 0 ? static_cast<size_t>(options.max_neighbours) : near.size();
       neighbours.clear();
       neighbour_distances.clear();
-      for (size_t j = 0; j < std::min(cap, found.size()); ++j) {
+      for (size_t j = 0; j < std::min(cap, near.size()); ++j) {
         // All, or evenly spread over the distance ranks, so that the context still spans the whole radius.
-        const size_t k = found.size() <= cap ? j : j * (found.size() - 1) / (cap - 1);
-        neighbours.push_back(static_cast<int>(found[k]));
-        neighbour_distances.push_back(std::sqrt(distances[s][k]));
+        const size_t k = near.size() <= cap ? j : j * (near.size() - 1) / (cap - 1);
+        neighbours.push_back(static_cast<int>(near[k]));
+        neighbour_distances.push_back(std::sqrt(found_squared[0][k]));
       }
       histograms.Describe(primitives, static_cast<int>(s * step), neighbours, neighbour_distances,
                           values.ptr<float>(static_cast<int>(s)));
+      described[s] = 1;
     }
   };
   std::vector<std::thread> workers;
@@ -291,7 +293,7 @@ Descriptors ComputeDescriptors(const std::vector<Primitive>& input, const Descri
 
   std::vector<int> rows;  // of `values`
   for (size_t s = 0; s < sources; ++s) {
-    if (neighbour_lists[s].size() < 2) continue;
+    if (described[s] == 0) continue;
     rows.push_back(static_cast<int>(s));
     descriptors.primitive.push_back(static_cast<int>(s * step));
   }
