@@ -6,6 +6,7 @@
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "app/commands.h"
@@ -115,6 +116,9 @@ int RunRecognize(const RecognizeArgs& args) {
   if (args.search_every > 1 && !args.track) ThrowInputError("recognize", "--search-every", "--track as well");
   std::vector<std::string> frames;
   if (!args.sequence.empty()) frames = ListSequenceFrames(args.sequence);
+  // One frame is read first: a broken one is reported before the library and its meshes (seconds) are loaded.
+  std::optional<LoadedFrame> single;
+  if (frames.empty()) single.emplace(app::LoadFrameWithWarnings(args.frame));
   LibraryLoadOptions load;
   load.names = args.models;
   load.build_matchers = false;  // the scene is indexed, the views are queried
@@ -125,8 +129,8 @@ int RunRecognize(const RecognizeArgs& args) {
   Recognizer recognizer(library, args.options);
   std::cerr << "recognize: meshes loaded for verification (" << MillisecondsSince(setup) << " ms)\n";
 
-  if (frames.empty()) {  // one frame
-    const LoadedFrame loaded = app::LoadFrameWithWarnings(args.frame);
+  if (single) {
+    const LoadedFrame& loaded = *single;
     const RecognitionResult result = recognizer.Recognize(loaded.rgbd);
     PrintDetections(loaded, result);
     if (!args.out_json.empty()) WriteJsonFile(args.out_json, RecognitionToJson(result));

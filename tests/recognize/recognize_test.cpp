@@ -297,6 +297,8 @@ TEST_F(RecognizeEndToEnd, BadInputIsReported) {
   const test::CommandResult missing_frame = test::RunCli("recognize --db " + library_ + " /nonexistent/000001");
   EXPECT_EQ(missing_frame.exit_code, 1) << missing_frame.output;
   EXPECT_NE(missing_frame.output.find("/nonexistent/000001"), std::string::npos) << missing_frame.output;
+  // Reported before the library and its meshes are loaded, not seconds later.
+  EXPECT_EQ(missing_frame.output.find("meshes loaded"), std::string::npos) << missing_frame.output;
   const test::CommandResult no_db = test::RunCli("recognize " + Frame());
   EXPECT_EQ(no_db.exit_code, 2) << no_db.output;
   const test::CommandResult untracked = test::RunCli("recognize --db " + library_ + " --sequence " +
