@@ -255,9 +255,8 @@ Descriptors ComputeDescriptors(const std::vector<Primitive>& input, const Descri
   const size_t sources = (primitives.size() + step - 1) / step;
 
   const AppearanceValues appearance = ComputeAppearance(primitives, options.appearance);
-  // Row s describes source s (primitive s * step); the rows of isolated sources are dropped at the end. The
-  // workers search each source's neighbours themselves: with the searches done up front on one thread, two
-  // workers took 44 instead of 49 ms for YCB-Video 0001/000001's 7439 primitives (4.5 cm shells); now 25 ms.
+  // Row s describes source s (primitive s * step); the rows of isolated sources are dropped at the end. Each
+  // worker searches its own sources' neighbours: on a dense frame the radius searches are a large share of the work.
   cv::Mat values(static_cast<int>(sources), kDescriptorSize, CV_32F);
   std::vector<char> described(sources, 0);  // not vector<bool>: written by the workers
   std::atomic<size_t> next{0};
