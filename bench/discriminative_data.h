@@ -21,15 +21,20 @@ struct ObjectView {
 
 /// Two views of one object with known relative pose: query (model side) and train (scene side).
 struct ViewPair {
-  std::string set;     ///< "recognition", "hard" or "easy"
+  std::string set;     ///< "recognition", "recognition in clutter", "hard" or "easy"
   std::string object;  ///< "003_cracker_box"
   bool held_out;       ///< from video 0002: not used to choose parameters
   ObjectView query, train;
+  /// The train view is the whole frame, as a recognition scene is: keypoints and descriptor support everywhere,
+  /// the clutter included, so that a query can also match the wrong object. Otherwise both views are cut to
+  /// the object's pixels.
+  bool clutter = false;
 
   Eigen::Isometry3d TrainFromQuery() const { return train.camera_from_object * query.camera_from_object.inverse(); }
 };
 
-/// The pairs of the three sets on the YCB-Video frames under `data_dir` (renders with OSMesa). The library
+/// The pairs of the four sets on the YCB-Video frames under `data_dir` (renders with OSMesa); the set
+/// "recognition in clutter" holds the recognition pairs again with `clutter` set. The library
 /// views are rendered `library_distance_m` from the object centre (0: as close as fits the image) with
 /// `shading`.
 std::vector<ViewPair> LoadViewPairs(const std::string& data_dir, double library_distance_m = 0.0,
