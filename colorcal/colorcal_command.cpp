@@ -271,7 +271,7 @@ CommandAction SetupColorcalCommand(CLI::App& command) {
       ->add_option("--max-depth-difference", args->max_depth_difference_m,
                    "Pixels are paired where rendered and real depth differ by at most this, metres")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(Positive());
   AddMethodFlag(*automatic, args.get());
   CLI::App* show = AddModelCommand(command, "show", "Print a model's stored colour matrix", args.get());
   CLI::App* clear = AddModelCommand(command, "clear", "Remove a model's colour matrix", args.get());

@@ -300,9 +300,7 @@ CLI::App* AddDatabaseCommand(CLI::App& command, const char* name, const char* su
 
 void AddBuildFlags(CLI::App& build, ModeldbArgs* args) {
   build.add_option("MESH_OR_DIR", args->inputs, "Mesh files, or directories of <name>/<name>.obj folders")->required();
-  build.add_option("--views", args->views, "Rendered views per model")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+  build.add_option("--views", args->views, "Rendered views per model")->capture_default_str()->check(AtLeastOne());
   AddMeshFlags(build, &args->mesh);
   build.add_option("--name", args->name, "Model name (one mesh only; default: the file stem or folder name)");
   build.add_option("--camera", args->camera, "Intrinsics fx,fy,cx,cy of the views (default: YCB-Video's)");
@@ -311,7 +309,7 @@ void AddBuildFlags(CLI::App& build, ModeldbArgs* args) {
       .add_option("--distance", args->distance_m,
                   "Camera distance from the object centre, metres; farther if the object would not fit (0: fit)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegative());
   build
       .add_option("--shading", args->shading,
                   "auto (headlight for meshes without a texture, unlit for textured ones), unlit (colours as "
@@ -322,7 +320,7 @@ void AddBuildFlags(CLI::App& build, ModeldbArgs* args) {
   build
       .add_option("--threads", args->threads,
                   "Worker threads describing each view (the same library for any count; default: all cores)")
-      ->check(CLI::PositiveNumber);
+      ->check(AtLeastOne());
   build.add_option("--feature-settings", args->feature_settings,
                    "JSON of extraction and descriptor settings, {\"ecv\": {...}, \"descriptor\": {...}} as "
                    "`modeldb info` shows them (missing fields: defaults)");

@@ -238,7 +238,8 @@ CommandAction SetupRecognizeCommand(CLI::App& command) {
       .add_option("--threads", options.ransac.threads,
                   "Worker threads for describing the scene and searching the models, one model each (same result for "
                   "any count)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(AtLeastOne());
   command.add_flag(
       "--no-icp", [&options = args->options](int64_t) { options.refine = false; }, "Skip the ICP refinement");
   command.add_flag("--track", args->track,

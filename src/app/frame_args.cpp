@@ -1,6 +1,8 @@
 #include "app/frame_args.h"
 
 #include <algorithm>
+#include <cmath>
+#include <functional>
 #include <iostream>
 #include <thread>
 #include <vector>
@@ -34,6 +36,38 @@ LoadedFrame LoadFrameWithWarnings(const FrameSpec& spec) {
 
 int AllCores() {
   return static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
+}
+
+namespace {
+
+// A validator accepting the numbers `accepts` takes; otherwise "expected <what>, got <text>".
+CLI::Validator NumberCheck(const std::string& what, const std::string& description,
+                           const std::function<bool(double)>& accepts, bool whole) {
+  return CLI::Validator(
+      [what, accepts, whole](std::string& text) {
+        double value = 0.0;
+        const bool number = CLI::detail::lexical_cast(text, value) && std::isfinite(value);
+        const bool ok = number && accepts(value) && (!whole || value == std::floor(value));
+        return ok ? std::string() : "expected " + what + ", got " + text;
+      },
+      description);
+}
+
+}  // namespace
+
+CLI::Validator AtLeastOne() {
+  return NumberCheck(
+      "a whole number of at least 1", "POSITIVE", [](double v) { return v >= 1.0; }, true);
+}
+
+CLI::Validator Positive() {
+  return NumberCheck(
+      "a number > 0", "POSITIVE", [](double v) { return v > 0.0; }, false);
+}
+
+CLI::Validator NonNegative() {
+  return NumberCheck(
+      "a number >= 0", "NONNEGATIVE", [](double v) { return v >= 0.0; }, false);
 }
 
 void AddMeshFlags(CLI::App& command, MeshArgs* args) {

@@ -86,5 +86,25 @@ TEST(Cli, BadInputExitsWithOneAndNamesTheFile) {
               AllOf(HasSubstr("warning"), HasSubstr("texture_map.png"), HasSubstr("colour    vertex colour")));
 }
 
+// Counts, sizes and distances out of range are usage errors (exit 2) whose message names the flag and what it takes,
+// before any file is read.
+TEST(Cli, NumericFlagsOutOfRangeSayWhatTheyExpect) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"modeldb build x.obj --db x.sqlite --views 0", "--views: expected a whole number of at least 1, got 0"},
+      {"modeldb build x.obj --db x.sqlite --threads 1.5", "--threads: expected a whole number of at least 1, got 1.5"},
+      {"modeldb build x.obj --db x.sqlite --distance -1", "--distance: expected a number >= 0, got -1"},
+      {"recognize --db x.sqlite frame --threads 0", "--threads: expected a whole number of at least 1, got 0"},
+      {"register a b --threads many", "--threads: expected a whole number of at least 1, got many"},
+      {"render x.obj --views 3 --out d --height 0", "--height: expected a whole number of at least 1, got 0"},
+      {"colorcal auto --db x.sqlite --model m frame --max-depth-difference 0",
+       "--max-depth-difference: expected a number > 0, got 0"},
+  };
+  for (const auto& [arguments, message] : cases) {
+    const test::CommandResult result = test::RunCli(arguments);
+    EXPECT_EQ(result.exit_code, 2) << arguments << "\n" << result.output;
+    EXPECT_THAT(result.output, HasSubstr(message)) << arguments;
+  }
+}
+
 }  // namespace
 }  // namespace ecv
