@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <functional>
 #include <iostream>
 #include <thread>
@@ -40,15 +41,15 @@ int AllCores() {
 
 namespace {
 
-// A validator accepting the numbers `accepts` takes; otherwise "expected <what>, got <text>".
+// A validator of numbers that `accepts`; anything else gets "expected <what>, got <text>".
 CLI::Validator NumberCheck(const std::string& what, const std::string& description,
-                           const std::function<bool(double)>& accepts, bool whole) {
+                           const std::function<bool(double)>& accepts) {
   return CLI::Validator(
-      [what, accepts, whole](std::string& text) {
-        double value = 0.0;
-        const bool number = CLI::detail::lexical_cast(text, value) && std::isfinite(value);
-        const bool ok = number && accepts(value) && (!whole || value == std::floor(value));
-        return ok ? std::string() : "expected " + what + ", got " + text;
+      [what, accepts](std::string& text) {
+        char* end = nullptr;
+        const double value = std::strtod(text.c_str(), &end);
+        const bool number = !text.empty() && end == text.c_str() + text.size() && std::isfinite(value);
+        return number && accepts(value) ? std::string() : "expected " + what + ", got " + text;
       },
       description);
 }
@@ -56,18 +57,16 @@ CLI::Validator NumberCheck(const std::string& what, const std::string& descripti
 }  // namespace
 
 CLI::Validator AtLeastOne() {
-  return NumberCheck(
-      "a whole number of at least 1", "POSITIVE", [](double v) { return v >= 1.0; }, true);
+  return NumberCheck("a whole number of at least 1", "POSITIVE",
+                     [](double v) { return v >= 1.0 && v == std::floor(v); });
 }
 
 CLI::Validator Positive() {
-  return NumberCheck(
-      "a number > 0", "POSITIVE", [](double v) { return v > 0.0; }, false);
+  return NumberCheck("a number > 0", "POSITIVE", [](double v) { return v > 0.0; });
 }
 
 CLI::Validator NonNegative() {
-  return NumberCheck(
-      "a number >= 0", "NONNEGATIVE", [](double v) { return v >= 0.0; }, false);
+  return NumberCheck("a number >= 0", "NONNEGATIVE", [](double v) { return v >= 0.0; });
 }
 
 void AddMeshFlags(CLI::App& command, MeshArgs* args) {
