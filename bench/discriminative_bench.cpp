@@ -234,7 +234,7 @@ cv::Scalar MethodColor(const std::string& name, size_t index) {
 
 cv::Mat BarChart(const std::vector<ViewPair>& pairs, const std::vector<std::string>& names,
                  const std::vector<std::vector<PairScore>>& scores) {
-  const std::vector<std::string> sets = {"recognition", "recognition in clutter", "hard", "easy"};
+  const std::vector<std::string>& sets = kPairSets;
   const int bar = 14, gap = 30, height = 300, top = 40, left = 50;
   const int group = static_cast<int>(names.size()) * bar;
   const int legend = 40 + 14 * static_cast<int>(names.size());
@@ -522,7 +522,7 @@ int main(int argc, char** argv) {
       "scene. SURF is not in Debian's "
       "OpenCV (no xfeatures2d), so it is absent. random = expected score of matching at random; ceiling = share of "
       "query keypoints with any true partner within 1 cm.\n\n";
-  for (const std::string set : {"recognition", "recognition in clutter", "hard", "easy"}) {
+  for (const std::string& set : kPairSets) {
     report += SetTable(set, pairs, names, scores);
   }
   report += ablations;

@@ -19,9 +19,12 @@ struct ObjectView {
   Eigen::Isometry3d camera_from_object;  ///< metres
 };
 
+/// The sets of view pairs, in the order the report shows them.
+inline const std::vector<std::string> kPairSets = {"recognition", "recognition in clutter", "hard", "easy"};
+
 /// Two views of one object with known relative pose: query (model side) and train (scene side).
 struct ViewPair {
-  std::string set;     ///< "recognition", "recognition in clutter", "hard" or "easy"
+  std::string set;     ///< one of kPairSets
   std::string object;  ///< "003_cracker_box"
   bool held_out;       ///< from video 0002: not used to choose parameters
   ObjectView query, train;
