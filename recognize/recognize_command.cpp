@@ -79,8 +79,8 @@ void PrintDetections(const LoadedFrame& loaded, const RecognitionResult& result)
   for (const Detection& d : result.detections) {
     std::cout << "  " << std::left << std::setw(24) << d.model << std::right << " score " << d.score << " (depth "
               << d.depth_agreement << ", colour " << d.color_agreement << ", fit " << std::setprecision(1)
-              << 1000.0 * d.surface_error_m << " mm" << std::setprecision(2) << "), inliers " << d.inlier_fraction
-              << ", view " << d.view << ", t = [" << std::setprecision(3)
+              << 1000.0 * d.surface_error_m << " mm" << std::setprecision(2) << ", outline " << d.contour_agreement
+              << "), inliers " << d.inlier_fraction << ", view " << d.view << ", t = [" << std::setprecision(3)
               << d.camera_from_object.translation().transpose() << "] m" << std::setprecision(2) << '\n';
     for (const GroundTruth& truth : loaded.ground_truth) {
       if (truth.object_name != d.model) continue;

@@ -42,6 +42,7 @@ struct Scene {
   std::vector<Eigen::Vector3f> ransac_points;  // primitive positions first, then the depth points at ransac_stride_px
   std::unique_ptr<RadiusGrid> ransac_grid;     // over ransac_points, radius the inlier threshold: built once
   cv::Mat color;                               // the frame's colours, as verification compares them
+  cv::Mat depth_steps;                         // DepthSteps of the frame, for verification's contour factor
   OrganizedScene organized;                    // the depth samples with normals, for projective ICP
   SceneVisibility visibility;
 };
@@ -197,6 +198,9 @@ void RecognizerOptions::Check() const {
   require(color_blur_px >= 0.0, "color_blur_px", ">= 0 pixels");
   require(residual_free_m >= 0.0, "residual_free_m", ">= 0 m");
   require(residual_falloff_m >= 0.0, "residual_falloff_m", ">= 0 m (0: no residual factor)");
+  require(contour_free >= 0.0 && contour_free <= 1.0, "contour_free", "in [0, 1]");
+  require(contour_falloff >= 0.0, "contour_falloff", ">= 0 (0: no contour factor)");
+  require(depth_step_m > 0.0, "depth_step_m", "> 0 m");
   require(min_score >= 0.0 && min_score <= 1.0, "min_score", "in [0, 1]");
   require(min_track_start_score >= 0.0 && min_track_start_score <= 1.0, "min_track_start_score", "in [0, 1]");
   require(min_visible_fraction >= 0.0 && min_visible_fraction <= 1.0, "min_visible_fraction", "in [0, 1]");
@@ -377,6 +381,8 @@ class Recognizer::Impl {
     }
     scene.visibility.depth = frame.depth;
     scene.visibility.camera = frame.camera;
+    // Grown by a pixel of the sampling: a pose a pixel or two off still has its outline on the step.
+    if (options_.contour_falloff > 0.0) scene.depth_steps = DepthSteps(frame.depth, options_.depth_step_m, 2);
     return scene;
   }
 
@@ -642,7 +648,15 @@ class Recognizer::Impl {
     detection.visible_fraction = rendered_pixels > 0 ? static_cast<double>(visible) / rendered_pixels : 0.0;
     detection.depth_agreement = visible > 0 ? static_cast<double>(on_surface) / visible : 0.0;
     detection.surface_error_m = on_surface > 0 ? residual_sum / on_surface : 0.0;
-    detection.score = detection.depth_agreement * detection.color_agreement * ResidualFactor(detection.surface_error_m);
+    double contour_factor = 1.0;
+    if (options_.contour_falloff > 0.0) {
+      detection.contour_agreement =
+          OutlineOnDepthSteps(rendered.depth, stride, frame.depth, scene.depth_steps, options_.depth_tolerance_m);
+      contour_factor =
+          std::clamp(1.0 - (options_.contour_free - detection.contour_agreement) / options_.contour_falloff, 0.0, 1.0);
+    }
+    detection.score = detection.depth_agreement * detection.color_agreement *
+                      ResidualFactor(detection.surface_error_m) * contour_factor;
     if (options_.reject_plane_patches && detection.score > 0.0 &&
         OnLargerPlane(frame, rendered.depth, verified.surface)) {
       detection.score = 0.0;
@@ -797,6 +811,7 @@ nlohmann::json RecognitionToJson(const RecognitionResult& result) {
                           {"color_agreement", d.color_agreement},
                           {"visible_fraction", d.visible_fraction},
                           {"surface_error", d.surface_error_m},
+                          {"contour_agreement", d.contour_agreement},
                           {"tracked", d.tracked}});
   }
   return {{"detections", detections}, {"timings_ms", result.timings_ms}, {"scene_primitives", result.scene_primitives}};

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numeric>
 
+#include <opencv2/imgproc.hpp>
+
 #include "core/error.h"
 #include "ecv/surface.h"
 
@@ -112,6 +114,50 @@ bool PatchOfLargerPlane(const std::vector<Eigen::Vector3f>& surface, const std::
     return static_cast<double>(on_plane) >= options.min_share * static_cast<double>(points.size());
   };
   return mostly_on_plane(surface) && mostly_on_plane(ring);
+}
+
+cv::Mat DepthSteps(const cv::Mat& depth, double step_m, int grow_px) {
+  CV_Assert(depth.type() == CV_32FC1);
+  cv::Mat steps = cv::Mat::zeros(depth.size(), CV_8UC1);
+  const auto step = static_cast<float>(step_m);
+  auto apart = [&](float a, float b) { return (a > 0.0F) != (b > 0.0F) || std::abs(a - b) > step; };
+  for (int v = 0; v < depth.rows; ++v) {
+    for (int u = 0; u < depth.cols; ++u) {
+      const float z = depth.at<float>(v, u);
+      if (u + 1 < depth.cols && apart(z, depth.at<float>(v, u + 1)))
+        steps.at<uchar>(v, u) = steps.at<uchar>(v, u + 1) = 255;
+      if (v + 1 < depth.rows && apart(z, depth.at<float>(v + 1, u)))
+        steps.at<uchar>(v, u) = steps.at<uchar>(v + 1, u) = 255;
+    }
+  }
+  if (grow_px > 0) {
+    cv::dilate(steps, steps, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * grow_px + 1, 2 * grow_px + 1)));
+  }
+  return steps;
+}
+
+double OutlineOnDepthSteps(const cv::Mat& rendered_depth, int stride, const cv::Mat& scene_depth,
+                           const cv::Mat& scene_steps, double hidden_margin_m) {
+  const auto margin = static_cast<float>(hidden_margin_m);
+  // Beyond the image counts as on the object: where the image cuts an object off, that is not its outline.
+  auto on_object = [&](int u, int v) {
+    return u < 0 || v < 0 || u >= rendered_depth.cols || v >= rendered_depth.rows ||
+           rendered_depth.at<float>(v, u) > 0.0F;
+  };
+  int outline = 0, on_step = 0;
+  for (int v = 0; v < rendered_depth.rows; ++v) {
+    for (int u = 0; u < rendered_depth.cols; ++u) {
+      if (rendered_depth.at<float>(v, u) <= 0.0F) continue;
+      if (on_object(u - 1, v) && on_object(u + 1, v) && on_object(u, v - 1) && on_object(u, v + 1)) continue;
+      const int scene_u = u * stride, scene_v = v * stride;
+      if (scene_u >= scene_depth.cols || scene_v >= scene_depth.rows) continue;
+      const float scene_z = scene_depth.at<float>(scene_v, scene_u);
+      if (scene_z > 0.0F && scene_z < rendered_depth.at<float>(v, u) - margin) continue;  // hidden
+      ++outline;
+      if (scene_steps.at<uchar>(scene_v, scene_u) != 0) ++on_step;
+    }
+  }
+  return outline > 0 ? static_cast<double>(on_step) / outline : 0.0;
 }
 
 // Normalised cross-correlation of (model, scene) colour pairs: the smaller of two. Per channel (averaged), it
