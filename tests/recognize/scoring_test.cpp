@@ -1,10 +1,12 @@
 // The recognizer's scores on constructed data: the consistent-set size of planted true correspondences
-// among false ones, and the colour correlation's invariance to gain and offset.
+// among false ones, the colour correlation's invariance to gain and offset, and how much of a pose's outline
+// runs along the scene's depth steps.
 
 #include <cmath>
 #include <random>
 
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
 #include "recognize/scoring.h"
@@ -180,6 +182,77 @@ TEST(PatchOfLargerPlane, AFaceAboveItsSurroundingsOrACurvedSurfaceIsNot) {
   PlanePatchOptions bad;
   bad.min_share = 0.0;
   EXPECT_THROW(PatchOfLargerPlane(waves, waves, bad), InputError);
+}
+
+// A table 1 m away (CV_32FC1, 80 x 60 pixels) with a box face 4 cm nearer on the pixels of `box`.
+cv::Mat TableWithBox(const cv::Rect& box) {
+  cv::Mat depth(60, 80, CV_32FC1, cv::Scalar(1.0F));
+  depth(box).setTo(0.96F);
+  return depth;
+}
+
+// The same box face rendered at a pose (the table not rendered: 0 off the object).
+cv::Mat Rendered(const cv::Rect& box) {
+  cv::Mat depth = cv::Mat::zeros(60, 80, CV_32FC1);
+  depth(box).setTo(0.96F);
+  return depth;
+}
+
+TEST(DepthSteps, MarksBothSidesOfAStepAndOfMissingDepthButNotSmallSteps) {
+  cv::Mat depth = TableWithBox({20, 20, 20, 20});
+  depth(cv::Rect(60, 0, 20, 60)).setTo(1.005F);  // a 5 mm step: the table goes on
+  depth.at<float>(5, 5) = 0.0F;                  // one pixel without depth
+  const cv::Mat steps = DepthSteps(depth, 0.01, 0);
+  EXPECT_EQ(steps.at<uchar>(20, 30), 255);  // the box's top row and the table row above it
+  EXPECT_EQ(steps.at<uchar>(19, 30), 255);
+  EXPECT_EQ(steps.at<uchar>(30, 39), 255);  // its right column and the table to the right
+  EXPECT_EQ(steps.at<uchar>(30, 40), 255);
+  EXPECT_EQ(steps.at<uchar>(30, 30), 0);  // inside the face
+  EXPECT_EQ(steps.at<uchar>(30, 60), 0);  // the small step
+  EXPECT_EQ(steps.at<uchar>(5, 5), 255);  // the hole and its neighbours
+  EXPECT_EQ(steps.at<uchar>(5, 6), 255);
+  EXPECT_EQ(steps.at<uchar>(5, 7), 0);
+  // Counted exactly: the box's outline of 4 x 20 - 4 pixels and the 4 x 20 + 4 table pixels around it (without the
+  // corners), the hole and its 4 neighbours.
+  EXPECT_EQ(cv::countNonZero(steps), 76 + 80 + 5);
+  const cv::Mat grown = DepthSteps(depth, 0.01, 2);
+  EXPECT_EQ(grown.at<uchar>(30, 42), 255);
+  EXPECT_EQ(grown.at<uchar>(30, 43), 0);
+}
+
+TEST(OutlineOnDepthSteps, IsOneForABoxStandingOutAndZeroForOneLyingFlatOnALargerFace) {
+  const cv::Rect box(20, 20, 20, 20);
+  const cv::Mat scene = TableWithBox(box);
+  const cv::Mat steps = DepthSteps(scene, 0.01, 2);
+  EXPECT_DOUBLE_EQ(OutlineOnDepthSteps(Rendered(box), 1, scene, steps, 0.015), 1.0);
+  // Rendered a pixel off, the grown steps still take the outline.
+  EXPECT_DOUBLE_EQ(OutlineOnDepthSteps(Rendered(box + cv::Point(1, 1)), 1, scene, steps, 0.015), 1.0);
+  // A smaller box on the big box's face: its whole outline lies on the face, away from the steps.
+  const cv::Rect inner(25, 25, 10, 10);
+  EXPECT_DOUBLE_EQ(OutlineOnDepthSteps(Rendered(inner), 1, scene, steps, 0.015), 0.0);
+  // Sampled every 2nd pixel (rendered at half the scene's size), the same.
+  cv::Mat half;
+  cv::resize(Rendered(box), half, cv::Size(40, 30), 0.0, 0.0, cv::INTER_NEAREST);
+  EXPECT_DOUBLE_EQ(OutlineOnDepthSteps(half, 2, scene, steps, 0.015), 1.0);
+}
+
+TEST(OutlineOnDepthSteps, LeavesOutHiddenOutlineAndTheImageBorder) {
+  const cv::Rect box(20, 20, 20, 20);
+  cv::Mat scene = TableWithBox(box);
+  const cv::Rect inner(25, 25, 10, 10);
+  // Something 10 cm in front covers the table and the big box up to column 27, and so the small box's left column
+  // and two pixels of its top and bottom rows: 14 of its 36 outline pixels, all near the new step (columns 25-30),
+  // are hidden and not counted. Of the 22 seen, the 6 in columns 28-30 of its top and bottom rows lie on that step.
+  cv::Mat hidden = scene.clone();
+  hidden(cv::Rect(0, 0, 28, 60)).setTo(0.86F);
+  EXPECT_DOUBLE_EQ(OutlineOnDepthSteps(Rendered(inner), 1, hidden, DepthSteps(hidden, 0.01, 2), 0.015), 6.0 / 22.0);
+  // Nothing of it seen: 0.
+  hidden.setTo(0.5F);
+  EXPECT_DOUBLE_EQ(OutlineOnDepthSteps(Rendered(inner), 1, hidden, DepthSteps(hidden, 0.01, 2), 0.015), 0.0);
+  // A box cut off by the image's left border: the border is not outline, the rest is on steps.
+  const cv::Rect cut(0, 20, 10, 20);
+  scene = TableWithBox(cut);
+  EXPECT_DOUBLE_EQ(OutlineOnDepthSteps(Rendered(cut), 1, scene, DepthSteps(scene, 0.01, 2), 0.015), 1.0);
 }
 
 }  // namespace
