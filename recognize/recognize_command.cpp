@@ -255,6 +255,10 @@ CommandAction SetupRecognizeCommand(CLI::App& command) {
       .add_option("--track-start-score", options.min_track_start_score,
                   "With --track: a new detection is followed into the next frame only from this score on")
       ->capture_default_str();
+  command.add_flag(
+      "--no-contour", [&options = args->options](int64_t) { options.contour_falloff = 0.0; },
+      "Verify without the contour factor (a pose's outline on the scene's depth steps): for flat objects thinner\n"
+      "than 1 cm lying on a surface, or parts packed flush in a tray");
   command.add_flag("--fast-icp", options.projective_icp,
                    "ICP pairs points along the camera's rays (7x faster refinement, finds fewer objects)");
   command.footer(

@@ -382,7 +382,7 @@ class Recognizer::Impl {
     scene.visibility.depth = frame.depth;
     scene.visibility.camera = frame.camera;
     // Grown by a pixel of the sampling: a pose a pixel or two off still has its outline on the step.
-    if (options_.contour_falloff > 0.0) scene.depth_steps = DepthSteps(frame.depth, options_.depth_step_m, 2);
+    scene.depth_steps = DepthSteps(frame.depth, options_.depth_step_m, 2);
     return scene;
   }
 
@@ -648,13 +648,13 @@ class Recognizer::Impl {
     detection.visible_fraction = rendered_pixels > 0 ? static_cast<double>(visible) / rendered_pixels : 0.0;
     detection.depth_agreement = visible > 0 ? static_cast<double>(on_surface) / visible : 0.0;
     detection.surface_error_m = on_surface > 0 ? residual_sum / on_surface : 0.0;
-    double contour_factor = 1.0;
-    if (options_.contour_falloff > 0.0) {
-      detection.contour_agreement =
-          OutlineOnDepthSteps(rendered.depth, stride, frame.depth, scene.depth_steps, options_.depth_tolerance_m);
-      contour_factor =
-          std::clamp(1.0 - (options_.contour_free - detection.contour_agreement) / options_.contour_falloff, 0.0, 1.0);
-    }
+    detection.contour_agreement =
+        OutlineOnDepthSteps(rendered.depth, stride, frame.depth, scene.depth_steps, options_.depth_tolerance_m);
+    const double contour_factor =
+        options_.contour_falloff > 0.0
+            ? std::clamp(1.0 - (options_.contour_free - detection.contour_agreement) / options_.contour_falloff, 0.0,
+                         1.0)
+            : 1.0;
     detection.score = detection.depth_agreement * detection.color_agreement *
                       ResidualFactor(detection.surface_error_m) * contour_factor;
     if (options_.reject_plane_patches && detection.score > 0.0 &&
