@@ -381,7 +381,7 @@ class Recognizer::Impl {
     }
     scene.visibility.depth = frame.depth;
     scene.visibility.camera = frame.camera;
-    // Grown by a pixel of the sampling: a pose a pixel or two off still has its outline on the step.
+    // Grown by 2 pixels, so that the outline of a pose a pixel or two off still lies on its object's step.
     scene.depth_steps = DepthSteps(frame.depth, options_.depth_step_m, 2);
     return scene;
   }

@@ -117,7 +117,9 @@ bool PatchOfLargerPlane(const std::vector<Eigen::Vector3f>& surface, const std::
 }
 
 cv::Mat DepthSteps(const cv::Mat& depth, double step_m, int grow_px) {
-  CV_Assert(depth.type() == CV_32FC1);
+  if (depth.type() != CV_32FC1) ThrowInputError("depth steps", "depth", "a CV_32FC1 image in metres");
+  if (!(step_m > 0.0)) ThrowInputError("depth steps", "step_m", "> 0 m");
+  if (grow_px < 0) ThrowInputError("depth steps", "grow_px", ">= 0 pixels");
   cv::Mat steps = cv::Mat::zeros(depth.size(), CV_8UC1);
   const auto step = static_cast<float>(step_m);
   auto apart = [&](float a, float b) { return (a > 0.0F) != (b > 0.0F) || std::abs(a - b) > step; };
@@ -138,6 +140,13 @@ cv::Mat DepthSteps(const cv::Mat& depth, double step_m, int grow_px) {
 
 double OutlineOnDepthSteps(const cv::Mat& rendered_depth, int stride, const cv::Mat& scene_depth,
                            const cv::Mat& scene_steps, double hidden_margin_m) {
+  if (rendered_depth.type() != CV_32FC1 || scene_depth.type() != CV_32FC1) {
+    ThrowInputError("outline on depth steps", "rendered_depth/scene_depth", "CV_32FC1 images in metres");
+  }
+  if (scene_steps.size() != scene_depth.size() || scene_steps.type() != CV_8UC1) {
+    ThrowInputError("outline on depth steps", "scene_steps", "a CV_8UC1 image of the scene depth's size");
+  }
+  if (stride < 1) ThrowInputError("outline on depth steps", "stride", "at least 1");
   const auto margin = static_cast<float>(hidden_margin_m);
   // Beyond the image counts as on the object: where the image cuts an object off, that is not its outline.
   auto on_object = [&](int u, int v) {

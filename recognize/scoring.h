@@ -54,7 +54,8 @@ bool PatchOfLargerPlane(const std::vector<Eigen::Vector3f>& surface, const std::
 
 /// The pixels of a depth image (CV_32FC1, metres, 0 = no measurement) at a depth step: a right or lower neighbour
 /// more than `step_m` nearer or further, or measured where this one is not (or the reverse); both pixels of a step
-/// are marked, then grown by `grow_px` pixels. CV_8UC1, 255 on them.
+/// are marked, then grown by `grow_px` pixels. CV_8UC1, 255 on them. Throws InputError on another image type or a
+/// step or growth out of range.
 cv::Mat DepthSteps(const cv::Mat& depth, double step_m, int grow_px);
 
 /// How much of an object's outline the scene shows as a depth step, 0..1: of the pixels on the outline of
@@ -62,7 +63,7 @@ cv::Mat DepthSteps(const cv::Mat& depth, double step_m, int grow_px);
 /// (stride u, stride v)) that the scene does not hide (no scene surface more than `hidden_margin_m` in front), the
 /// share on `scene_steps` (DepthSteps of the scene). 0 when no outline pixel is seen. An object lifts off what is
 /// behind it, so a right pose's outline runs along depth steps; a pose that lies flat on a larger surface (a
-/// small box on a big box's face) has no step along its outline.
+/// small box on a big box's face) has no step along its outline. Throws InputError when the images do not fit.
 double OutlineOnDepthSteps(const cv::Mat& rendered_depth, int stride, const cv::Mat& scene_depth,
                            const cv::Mat& scene_steps, double hidden_margin_m);
 

@@ -218,6 +218,12 @@ TEST(DepthSteps, MarksBothSidesOfAStepAndOfMissingDepthButNotSmallSteps) {
   const cv::Mat grown = DepthSteps(depth, 0.01, 2);
   EXPECT_EQ(grown.at<uchar>(30, 42), 255);
   EXPECT_EQ(grown.at<uchar>(30, 43), 0);
+  cv::Mat millimetres;
+  depth.convertTo(millimetres, CV_16UC1, 1000.0);
+  EXPECT_THROW(DepthSteps(millimetres, 0.01, 0), InputError);
+  EXPECT_THROW(DepthSteps(depth, 0.0, 0), InputError);
+  EXPECT_THROW(OutlineOnDepthSteps(Rendered({20, 20, 20, 20}), 1, depth, steps(cv::Rect(0, 0, 40, 30)), 0.015),
+               InputError);
 }
 
 TEST(OutlineOnDepthSteps, IsOneForABoxStandingOutAndZeroForOneLyingFlatOnALargerFace) {
