@@ -201,6 +201,7 @@ void RecognizerOptions::Check() const {
   require(contour_free >= 0.0 && contour_free <= 1.0, "contour_free", "in [0, 1]");
   require(contour_falloff >= 0.0, "contour_falloff", ">= 0 (0: no contour factor)");
   require(depth_step_m > 0.0, "depth_step_m", "> 0 m");
+  require(min_outline_samples >= 0, "min_outline_samples", ">= 0");
   require(min_score >= 0.0 && min_score <= 1.0, "min_score", "in [0, 1]");
   require(min_track_start_score >= 0.0 && min_track_start_score <= 1.0, "min_track_start_score", "in [0, 1]");
   require(min_visible_fraction >= 0.0 && min_visible_fraction <= 1.0, "min_visible_fraction", "in [0, 1]");
@@ -648,13 +649,11 @@ class Recognizer::Impl {
     detection.visible_fraction = rendered_pixels > 0 ? static_cast<double>(visible) / rendered_pixels : 0.0;
     detection.depth_agreement = visible > 0 ? static_cast<double>(on_surface) / visible : 0.0;
     detection.surface_error_m = on_surface > 0 ? residual_sum / on_surface : 0.0;
-    detection.contour_agreement =
+    const OutlineOnSteps outline =
         OutlineOnDepthSteps(rendered.depth, stride, frame.depth, scene.depth_steps, options_.depth_tolerance_m);
+    detection.contour_agreement = outline.Share();
     const double contour_factor =
-        options_.contour_falloff > 0.0
-            ? std::clamp(1.0 - (options_.contour_free - detection.contour_agreement) / options_.contour_falloff, 0.0,
-                         1.0)
-            : 1.0;
+        ContourFactor(outline, options_.contour_free, options_.contour_falloff, options_.min_outline_samples);
     detection.score = detection.depth_agreement * detection.color_agreement *
                       ResidualFactor(detection.surface_error_m) * contour_factor;
     if (options_.reject_plane_patches && detection.score > 0.0 &&

@@ -114,6 +114,9 @@ struct RecognizerOptions {
   double contour_free = 0.3;
   double contour_falloff = 0.2;
   double depth_step_m = 0.01;
+  /// A pose with fewer outline samples (at dense_stride_px) seen than this gets a contour factor of 1: an object
+  /// filling the image, or hidden but for a patch, shows too little outline to tell.
+  int min_outline_samples = 20;
   double min_score = 0.3;  ///< detections below are dropped
   /// Tracking: a prior that was not itself tracked (a detection's first appearance) is followed only when it
   /// scored at least this; once followed, it is kept while it scores min_score. A false detection near
@@ -173,7 +176,7 @@ struct Detection {
   double depth_agreement = 0.0;    ///< share of the visible rendered pixels on the scene surface
   double color_agreement = 0.0;    ///< correlation of the rendered colours with the scene's on those, 0..1
   double surface_error_m = 0.0;    ///< mean |rendered - scene depth| on those, metres
-  double contour_agreement = 0.0;  ///< share of the seen outline on a scene depth step (OutlineOnDepthSteps)
+  double contour_agreement = 0.0;  ///< share of the seen outline on a scene depth step (0: none seen)
   double visible_fraction = 0.0;   ///< share of the rendered pixels the scene can show (not hidden, with depth)
   bool tracked = false;            ///< found from a prior (the previous frame's pose), without RANSAC
 };

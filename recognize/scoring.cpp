@@ -138,8 +138,8 @@ cv::Mat DepthSteps(const cv::Mat& depth, double step_m, int grow_px) {
   return steps;
 }
 
-double OutlineOnDepthSteps(const cv::Mat& rendered_depth, int stride, const cv::Mat& scene_depth,
-                           const cv::Mat& scene_steps, double hidden_margin_m) {
+OutlineOnSteps OutlineOnDepthSteps(const cv::Mat& rendered_depth, int stride, const cv::Mat& scene_depth,
+                                   const cv::Mat& scene_steps, double hidden_margin_m) {
   if (rendered_depth.type() != CV_32FC1 || scene_depth.type() != CV_32FC1) {
     ThrowInputError("outline on depth steps", "rendered_depth/scene_depth", "CV_32FC1 images in metres");
   }
@@ -153,7 +153,7 @@ double OutlineOnDepthSteps(const cv::Mat& rendered_depth, int stride, const cv::
     return u < 0 || v < 0 || u >= rendered_depth.cols || v >= rendered_depth.rows ||
            rendered_depth.at<float>(v, u) > 0.0F;
   };
-  int outline = 0, on_step = 0;
+  OutlineOnSteps outline;
   for (int v = 0; v < rendered_depth.rows; ++v) {
     for (int u = 0; u < rendered_depth.cols; ++u) {
       if (rendered_depth.at<float>(v, u) <= 0.0F) continue;
@@ -162,11 +162,16 @@ double OutlineOnDepthSteps(const cv::Mat& rendered_depth, int stride, const cv::
       if (scene_u >= scene_depth.cols || scene_v >= scene_depth.rows) continue;
       const float scene_z = scene_depth.at<float>(scene_v, scene_u);
       if (scene_z > 0.0F && scene_z < rendered_depth.at<float>(v, u) - margin) continue;  // hidden
-      ++outline;
-      if (scene_steps.at<uchar>(scene_v, scene_u) != 0) ++on_step;
+      ++outline.seen;
+      if (scene_steps.at<uchar>(scene_v, scene_u) != 0) ++outline.on_step;
     }
   }
-  return outline > 0 ? static_cast<double>(on_step) / outline : 0.0;
+  return outline;
+}
+
+double ContourFactor(const OutlineOnSteps& outline, double free, double falloff, int min_seen) {
+  if (falloff <= 0.0 || outline.seen < min_seen) return 1.0;
+  return std::clamp(1.0 - (free - outline.Share()) / falloff, 0.0, 1.0);
 }
 
 // Normalised cross-correlation of (model, scene) colour pairs: the smaller of two. Per channel (averaged), it

@@ -58,14 +58,27 @@ bool PatchOfLargerPlane(const std::vector<Eigen::Vector3f>& surface, const std::
 /// step or growth out of range.
 cv::Mat DepthSteps(const cv::Mat& depth, double step_m, int grow_px);
 
-/// How much of an object's outline the scene shows as a depth step, 0..1: of the pixels on the outline of
+/// Outline pixels of a rendered pose that the scene shows, and how many of them lie on a depth step.
+struct OutlineOnSteps {
+  int seen = 0;
+  int on_step = 0;
+  double Share() const { return seen > 0 ? static_cast<double>(on_step) / seen : 0.0; }
+};
+
+/// How much of an object's outline the scene shows as a depth step: of the pixels on the outline of
 /// `rendered_depth` (the object rendered at a pose, CV_32FC1 metres, 0 off the object; pixel (u, v) is scene pixel
-/// (stride u, stride v)) that the scene does not hide (no scene surface more than `hidden_margin_m` in front), the
-/// share on `scene_steps` (DepthSteps of the scene). 0 when no outline pixel is seen. An object lifts off what is
-/// behind it, so a right pose's outline runs along depth steps; a pose that lies flat on a larger surface (a
-/// small box on a big box's face) has no step along its outline. Throws InputError when the images do not fit.
-double OutlineOnDepthSteps(const cv::Mat& rendered_depth, int stride, const cv::Mat& scene_depth,
-                           const cv::Mat& scene_steps, double hidden_margin_m);
+/// (stride u, stride v)) those the scene does not hide (no scene surface more than `hidden_margin_m` in front), and
+/// how many lie on `scene_steps` (DepthSteps of the scene). Where the image cuts the object off is not outline. An
+/// object lifts off what is behind it, so a right pose's outline runs along depth steps; a pose that lies flat on a
+/// larger surface (a small box on a big box's face) has no step along its outline. Throws InputError when the
+/// images do not fit.
+OutlineOnSteps OutlineOnDepthSteps(const cv::Mat& rendered_depth, int stride, const cv::Mat& scene_depth,
+                                   const cv::Mat& scene_steps, double hidden_margin_m);
+
+/// Verification's contour factor: 1 when fewer than `min_seen` outline pixels are seen (an object cut off by the
+/// image all round, or hidden but for a patch: the outline cannot tell), else 1 from a share of `free` on the
+/// steps, falling linearly to 0 over `falloff` below; `falloff` 0: always 1.
+double ContourFactor(const OutlineOnSteps& outline, double free, double falloff, int min_seen);
 
 /// Normalised cross-correlation of (model, scene) colour pairs in [0, 1]; 0 for fewer than 10 pairs. High when
 /// the model's texture lies where the scene shows it, whatever the brightness and white balance of the light:

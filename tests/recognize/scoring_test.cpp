@@ -230,16 +230,18 @@ TEST(OutlineOnDepthSteps, IsOneForABoxStandingOutAndZeroForOneLyingFlatOnALarger
   const cv::Rect box(20, 20, 20, 20);
   const cv::Mat scene = TableWithBox(box);
   const cv::Mat steps = DepthSteps(scene, 0.01, 2);
-  EXPECT_DOUBLE_EQ(OutlineOnDepthSteps(Rendered(box), 1, scene, steps, 0.015), 1.0);
+  EXPECT_DOUBLE_EQ(OutlineOnDepthSteps(Rendered(box), 1, scene, steps, 0.015).Share(), 1.0);
   // Rendered a pixel off, the grown steps still take the outline.
-  EXPECT_DOUBLE_EQ(OutlineOnDepthSteps(Rendered(box + cv::Point(1, 1)), 1, scene, steps, 0.015), 1.0);
+  EXPECT_DOUBLE_EQ(OutlineOnDepthSteps(Rendered(box + cv::Point(1, 1)), 1, scene, steps, 0.015).Share(), 1.0);
   // A smaller box on the big box's face: its whole outline lies on the face, away from the steps.
   const cv::Rect inner(25, 25, 10, 10);
-  EXPECT_DOUBLE_EQ(OutlineOnDepthSteps(Rendered(inner), 1, scene, steps, 0.015), 0.0);
+  const OutlineOnSteps flat = OutlineOnDepthSteps(Rendered(inner), 1, scene, steps, 0.015);
+  EXPECT_EQ(flat.seen, 36);
+  EXPECT_EQ(flat.on_step, 0);
   // Sampled every 2nd pixel (rendered at half the scene's size), the same.
   cv::Mat half;
   cv::resize(Rendered(box), half, cv::Size(40, 30), 0.0, 0.0, cv::INTER_NEAREST);
-  EXPECT_DOUBLE_EQ(OutlineOnDepthSteps(half, 2, scene, steps, 0.015), 1.0);
+  EXPECT_DOUBLE_EQ(OutlineOnDepthSteps(half, 2, scene, steps, 0.015).Share(), 1.0);
 }
 
 TEST(OutlineOnDepthSteps, LeavesOutHiddenOutlineAndTheImageBorder) {
@@ -251,14 +253,31 @@ TEST(OutlineOnDepthSteps, LeavesOutHiddenOutlineAndTheImageBorder) {
   // are hidden and not counted. Of the 22 seen, the 6 in columns 28-30 of its top and bottom rows lie on that step.
   cv::Mat hidden = scene.clone();
   hidden(cv::Rect(0, 0, 28, 60)).setTo(0.86F);
-  EXPECT_DOUBLE_EQ(OutlineOnDepthSteps(Rendered(inner), 1, hidden, DepthSteps(hidden, 0.01, 2), 0.015), 6.0 / 22.0);
+  const OutlineOnSteps partly = OutlineOnDepthSteps(Rendered(inner), 1, hidden, DepthSteps(hidden, 0.01, 2), 0.015);
+  EXPECT_EQ(partly.seen, 22);
+  EXPECT_EQ(partly.on_step, 6);
   // Nothing of it seen: 0.
   hidden.setTo(0.5F);
-  EXPECT_DOUBLE_EQ(OutlineOnDepthSteps(Rendered(inner), 1, hidden, DepthSteps(hidden, 0.01, 2), 0.015), 0.0);
+  EXPECT_EQ(OutlineOnDepthSteps(Rendered(inner), 1, hidden, DepthSteps(hidden, 0.01, 2), 0.015).seen, 0);
   // A box cut off by the image's left border: the border is not outline, the rest is on steps.
   const cv::Rect cut(0, 20, 10, 20);
   scene = TableWithBox(cut);
-  EXPECT_DOUBLE_EQ(OutlineOnDepthSteps(Rendered(cut), 1, scene, DepthSteps(scene, 0.01, 2), 0.015), 1.0);
+  EXPECT_DOUBLE_EQ(OutlineOnDepthSteps(Rendered(cut), 1, scene, DepthSteps(scene, 0.01, 2), 0.015).Share(), 1.0);
+  // A box filling the image has no outline at all.
+  const cv::Rect all(0, 0, 80, 60);
+  scene = TableWithBox(all);
+  EXPECT_EQ(OutlineOnDepthSteps(Rendered(all), 1, scene, DepthSteps(scene, 0.01, 2), 0.015).seen, 0);
+}
+
+TEST(ContourFactor, OneFromTheFreeShareZeroBelowTheFalloffAndOneWhenTooLittleOutlineIsSeen) {
+  EXPECT_DOUBLE_EQ(ContourFactor({100, 30}, 0.3, 0.2, 20), 1.0);
+  EXPECT_DOUBLE_EQ(ContourFactor({100, 90}, 0.3, 0.2, 20), 1.0);
+  EXPECT_NEAR(ContourFactor({100, 20}, 0.3, 0.2, 20), 0.5, 1e-12);
+  EXPECT_NEAR(ContourFactor({100, 10}, 0.3, 0.2, 20), 0.0, 1e-12);
+  EXPECT_DOUBLE_EQ(ContourFactor({100, 0}, 0.3, 0.2, 20), 0.0);
+  EXPECT_DOUBLE_EQ(ContourFactor({19, 0}, 0.3, 0.2, 20), 1.0);  // too little outline to tell
+  EXPECT_DOUBLE_EQ(ContourFactor({0, 0}, 0.3, 0.2, 20), 1.0);
+  EXPECT_DOUBLE_EQ(ContourFactor({100, 0}, 0.3, 0.0, 20), 1.0);  // no factor
 }
 
 }  // namespace
