@@ -82,6 +82,10 @@ class Estimator {
     std::mt19937_64 random(options.seed);
     std::shuffle(order_.begin(), order_.end(), random);
     if (options.sample_radius_m > 0.0) FindSampleNeighbours();
+    const auto support = std::max<size_t>(
+        static_cast<size_t>(options.min_support),
+        static_cast<size_t>(std::ceil(options.min_support_share * static_cast<double>(correspondences.size()))));
+    if (support > 0) required_agreeing_ = static_cast<size_t>(options.sample_size) + support;
   }
 
   struct Best {
@@ -92,7 +96,7 @@ class Estimator {
   };
   struct BlockOutcome {
     Best best;
-    int iterations = 0, rejected_by_polygon = 0;
+    int iterations = 0, rejected_by_polygon = 0, rejected_by_support = 0;
     double agreeing = 0.0;  // largest share of agreeing correspondences of an accepted pose
     bool stopped_early = false;
   };
@@ -105,13 +109,18 @@ class Estimator {
 
   // Share of the correspondences whose object point lands within eps of its scene point under `pose`.
   double AgreeingShare(const Eigen::Isometry3d& pose) const {
+    return static_cast<double>(AgreeingCount(pose)) / static_cast<double>(correspondences_.size());
+  }
+
+  // How many correspondences' object points land within eps of their scene points under `pose`.
+  size_t AgreeingCount(const Eigen::Isometry3d& pose) const {
     const Eigen::Isometry3f transform = pose.cast<float>();
     const float eps_squared = static_cast<float>(options_.inlier_threshold_m * options_.inlier_threshold_m);
-    const auto agreeing = std::count_if(correspondences_.begin(), correspondences_.end(), [&](const Correspondence& c) {
-      return (transform * object_[static_cast<size_t>(c.object)] - scene_[static_cast<size_t>(c.scene)])
-                 .squaredNorm() <= eps_squared;
-    });
-    return static_cast<double>(agreeing) / static_cast<double>(correspondences_.size());
+    return static_cast<size_t>(
+        std::count_if(correspondences_.begin(), correspondences_.end(), [&](const Correspondence& c) {
+          return (transform * object_[static_cast<size_t>(c.object)] - scene_[static_cast<size_t>(c.scene)])
+                     .squaredNorm() <= eps_squared;
+        }));
   }
 
   BlockOutcome RunBlock(int block, int size) const {
@@ -137,7 +146,12 @@ class Estimator {
         continue;
       }
       Eigen::Isometry3d pose;
-      if (!FitRigid(object_sample, scene_sample, &pose) || !FindInliers(pose, &inliers)) continue;
+      if (!FitRigid(object_sample, scene_sample, &pose)) continue;
+      if (required_agreeing_ > 0 && AgreeingCount(pose) < required_agreeing_) {
+        ++outcome.rejected_by_support;
+        continue;
+      }
+      if (!FindInliers(pose, &inliers)) continue;
       // Re-estimate on the inliers; the fit error is that of the same inlier pairs under the new pose.
       if (!FitRigid(inliers.object, inliers.scene, &pose)) continue;
       const double error = MeanPairDistance(pose, inliers);
@@ -251,6 +265,7 @@ class Estimator {
   const RansacOptions& options_;
   const SceneVisibility* visibility_;
   const RadiusGrid& tree_;
+  size_t required_agreeing_ = 0;              // correspondences that must agree with a sample's pose (0: no test)
   std::vector<int> order_;                    // object points in a fixed random order, for the preverification
   std::vector<std::vector<int>> neighbours_;  // per correspondence, when sampling is local (sample_radius_m)
 };
@@ -270,6 +285,8 @@ void RansacOptions::Check() const {
   require(expected_inlier_ratio > 0.0 && expected_inlier_ratio <= 1.0, "expected_inlier_ratio", "in (0, 1]");
   require(max_iterations >= 0, "max_iterations", ">= 0 (0: from p, w and n)");
   require(threads >= 1, "threads", "at least 1");
+  require(min_support >= 0, "min_support", ">= 0 (0: no test)");
+  require(min_support_share >= 0.0 && min_support_share <= 1.0, "min_support_share", "in [0, 1] (0: no test)");
 }
 
 int RansacOptions::Iterations() const {
@@ -377,6 +394,7 @@ RansacResult EstimatePoseRansac(const std::vector<Eigen::Vector3f>& object_point
     const Estimator::BlockOutcome& outcome = outcomes[static_cast<size_t>(block)];
     result.iterations += outcome.iterations;
     result.rejected_by_polygon += outcome.rejected_by_polygon;
+    result.rejected_by_support += outcome.rejected_by_support;
     if (Estimator::Better(outcome.best, best)) best = outcome.best;
   }
   if (best.inliers > 0) result.correspondence_inlier_ratio = estimator.AgreeingShare(best.pose);

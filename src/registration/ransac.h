@@ -48,6 +48,14 @@ struct RansacOptions {
   /// paper). Set to the object's diameter, a sample whose first correspondence is true is then all true with
   /// probability w'^(n-1), w' the share of true ones near the object, instead of w^(n-1) over the whole scene.
   double sample_radius_m = 0.0;
+  /// Beyond the paper: a sample's pose is dropped before its inliers are counted unless, besides the sample's
+  /// own, at least max(min_support, ceil(min_support_share x the correspondences)) correspondences agree with it
+  /// (within inlier_threshold_m). Counting them costs a transform per correspondence; counting inliers costs a
+  /// nearest-point search per object point, and in a cluttered scene most poses near a surface pass the inlier
+  /// test. A wrong pose gathers agreeing correspondences by chance, more of them the more there are, hence the
+  /// share. Both 0: every pose is counted, as in the paper.
+  int min_support = 0;
+  double min_support_share = 0.0;
 
   /// Throws InputError on values outside their ranges.
   void Check() const;
@@ -79,6 +87,7 @@ struct RansacResult {
   double fit_error_m = 0.0;                  ///< mean distance of the inlier pairs under the re-estimated pose, metres
   int iterations = 0;                        ///< samples drawn
   int rejected_by_polygon = 0;               ///< samples the polygon test dropped before a pose was computed
+  int rejected_by_support = 0;               ///< poses dropped by min_support(_share) before their inliers were counted
   double time_ms = 0.0;
 };
 

@@ -148,6 +148,50 @@ TEST(Ransac, SameSeedSameResult) {
   EXPECT_EQ(first.fit_error_m, second.fit_error_m);
 }
 
+// The support test (min_support, min_support_share) drops the poses of wrong samples before their inliers are
+// counted and leaves the result as it was: the right pose has a hundred agreeing correspondences.
+TEST(Ransac, TheSupportTestDropsWrongPosesBeforeTheirInlierCountAndKeepsTheResult) {
+  const Problem problem = MakeProblem(500, 100, 1000, 0.0005, 5);
+  RansacOptions options;
+  options.expected_inlier_ratio = 0.1;
+  options.inlier_threshold_m = 0.003;
+  options.prefer_agreeing = true;
+  options.polygon_threshold = 0.0;
+  const RansacResult plain = EstimatePoseRansac(problem.object, problem.scene, problem.correspondences, options);
+  ASSERT_TRUE(plain.success);
+  EXPECT_EQ(plain.rejected_by_support, 0);
+
+  options.min_support = 3;  // 3 correspondences besides the sample's own
+  const RansacResult tested = EstimatePoseRansac(problem.object, problem.scene, problem.correspondences, options);
+  ASSERT_TRUE(tested.success);
+  EXPECT_EQ(tested.scene_from_object.matrix(), plain.scene_from_object.matrix());
+  EXPECT_EQ(tested.inlier_fraction, plain.inlier_fraction);
+  EXPECT_EQ(tested.iterations, plain.iterations);
+  // A sample is all true with probability 0.1^3, so nearly every pose is wrong and dropped.
+  EXPECT_GT(tested.rejected_by_support, tested.iterations * 95 / 100);
+
+  // The same bar as a share: ceil(0.0021 x 1000) = 3; the larger of the two counts.
+  options.min_support = 1;
+  options.min_support_share = 0.0021;
+  const RansacResult shared = EstimatePoseRansac(problem.object, problem.scene, problem.correspondences, options);
+  EXPECT_EQ(shared.rejected_by_support, tested.rejected_by_support);
+  EXPECT_EQ(shared.scene_from_object.matrix(), plain.scene_from_object.matrix());
+
+  // More than there are: every pose is dropped. The polygon test takes the degenerate samples (a correspondence
+  // drawn twice, two with one object point), so every other sample reaches the support test.
+  options.min_support = 998;
+  options.polygon_threshold = 0.25;
+  const RansacResult none = EstimatePoseRansac(problem.object, problem.scene, problem.correspondences, options);
+  EXPECT_FALSE(none.success);
+  EXPECT_GT(none.rejected_by_support, 0);
+  EXPECT_EQ(none.rejected_by_support + none.rejected_by_polygon, none.iterations);
+
+  options.min_support = -1;
+  EXPECT_THROW(options.Check(), InputError);
+  options.min_support = 0;
+  options.min_support_share = 1.5;
+  EXPECT_THROW(options.Check(), InputError);
+}
 // A grid built once for many runs (the recognizer's, one per frame) gives what each run's own grid gives; a grid
 // over other points, or of another radius, is refused by name.
 TEST(Ransac, ASharedSceneGridGivesTheSameResultAndAWrongOneIsRefused) {
