@@ -9,17 +9,19 @@
 #include <opencv2/flann.hpp>
 
 #include "core/error.h"
+#include "core/kd_forest.h"
 #include "core/point_index.h"
 
 namespace ecv {
 
-// One FLANN index (OpenCV's) over the train descriptors of one type (or of all), with the rows' primitive
-// indices. OpenCV's copy of FLANN is used because its randomised kd-trees draw from seedable generators;
-// Debian's libflann shuffles them with std::random_device, so its matches differ from run to run.
+// One index over the train descriptors of one type (or of all), with the rows' primitive indices: FLANN
+// (OpenCV's) or a KdForest. OpenCV's copy of FLANN is used because its randomised kd-trees draw from seedable
+// generators; Debian's libflann shuffles them with std::random_device, so its matches differ from run to run.
 struct DescriptorMatcher::Index {
   cv::Mat values;              // owned copy: FLANN keeps pointers into it
   std::vector<int> primitive;  // train primitive of each row
-  std::unique_ptr<cv::flann::Index> index;
+  std::unique_ptr<cv::flann::Index> flann;
+  std::unique_ptr<KdForest> forest;
 };
 
 namespace {
@@ -44,7 +46,9 @@ void SelectRows(const Descriptors& descriptors, Keep keep, cv::Mat* values, std:
 
 void MatchOptions::Check() const {
   if (k < 1) ThrowInputError("match options", "k", "at least 1 neighbour", std::to_string(k));
-  if (trees < 1 || checks < 1) ThrowInputError("match options", "trees/checks", "positive values");
+  if (trees < 1 || checks < 1 || leaf_size < 1) {
+    ThrowInputError("match options", "trees/checks/leaf_size", "positive values");
+  }
 }
 
 DescriptorMatcher::DescriptorMatcher(const std::vector<Primitive>& train_primitives, const Descriptors& train,
@@ -58,7 +62,12 @@ DescriptorMatcher::DescriptorMatcher(const std::vector<Primitive>& train_primiti
         train,
         [&](int i) { return types == 1 || static_cast<int>(train_primitives[static_cast<size_t>(i)].type) == type; },
         &index->values, &index->primitive);
-    if (index->values.rows > 0) {
+    if (index->values.rows > 0 && options_.index == MatchIndex::kKdForest) {
+      KdForestOptions forest;
+      forest.trees = options_.trees;
+      forest.leaf_size = options_.leaf_size;
+      index->forest = std::make_unique<KdForest>(index->values, forest);
+    } else if (index->values.rows > 0) {
       // The trees draw from std::rand and OpenCV's generator: both seeded, under a lock, so that the same
       // descriptors always give the same trees (and the same matches).
       static std::mutex seed_mutex;
@@ -66,10 +75,10 @@ DescriptorMatcher::DescriptorMatcher(const std::vector<Primitive>& train_primiti
       std::srand(1);
       cv::theRNG().state = 1;
       if (index->values.rows < options_.exact_below) {
-        index->index =
+        index->flann =
             std::make_unique<cv::flann::Index>(index->values, cv::flann::LinearIndexParams(), cvflann::FLANN_DIST_L2);
       } else {
-        index->index = std::make_unique<cv::flann::Index>(index->values, cv::flann::KDTreeIndexParams(options_.trees),
+        index->flann = std::make_unique<cv::flann::Index>(index->values, cv::flann::KDTreeIndexParams(options_.trees),
                                                           cvflann::FLANN_DIST_L2);
       }
     }
@@ -84,7 +93,7 @@ std::vector<DescriptorMatch> DescriptorMatcher::Match(const std::vector<Primitiv
   std::vector<DescriptorMatch> matches;
   for (size_t type = 0; type < indices_.size(); ++type) {
     const Index& index = *indices_[type];
-    if (!index.index) continue;
+    if (index.values.rows == 0) continue;
     cv::Mat values;
     std::vector<int> primitive;
     SelectRows(
@@ -96,7 +105,12 @@ std::vector<DescriptorMatch> DescriptorMatcher::Match(const std::vector<Primitiv
     if (values.rows == 0) continue;
     const int k = std::min(options_.k, index.values.rows);
     cv::Mat neighbours, squared;
-    index.index->knnSearch(values, neighbours, squared, k, cv::flann::SearchParams(options_.checks));
+    if (index.forest) {
+      const int checks = index.values.rows < options_.exact_below ? index.values.rows : options_.checks;
+      index.forest->Search(values, k, checks, &neighbours, &squared);
+    } else {
+      index.flann->knnSearch(values, neighbours, squared, k, cv::flann::SearchParams(options_.checks));
+    }
     for (int q = 0; q < neighbours.rows; ++q) {
       for (int rank = 0; rank < k; ++rank) {
         const int train = neighbours.at<int>(q, rank);

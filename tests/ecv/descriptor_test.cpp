@@ -363,22 +363,26 @@ TEST(EcvMatching, FindsTheMovedCopyOfEachPrimitive) {
   const Eigen::Isometry3d motion = SomeRigidMotion();
   const std::vector<Primitive> object = Moved(scene, motion.inverse());  // the same primitives, elsewhere
   const Descriptors scene_descriptors = ComputeDescriptors(scene), object_descriptors = ComputeDescriptors(object);
-  for (const int exact_below : {100000, 10}) {  // exact, then approximate (randomised kd-trees)
-    MatchOptions options;
-    options.exact_below = exact_below;
-    options.k = 2;
-    const DescriptorMatcher matcher(scene, scene_descriptors, options);
-    const std::vector<DescriptorMatch> matches = matcher.Match(object, object_descriptors);
-    ASSERT_EQ(matches.size(), 2 * object_descriptors.primitive.size());
-    int right = 0;
-    for (const DescriptorMatch& match : matches) {
-      if (match.rank != 0) continue;
-      EXPECT_EQ(scene[static_cast<size_t>(match.train)].type, object[static_cast<size_t>(match.query)].type);
-      right += match.train == match.query ? 1 : 0;
+  for (const MatchIndex index : {MatchIndex::kFlann, MatchIndex::kKdForest}) {
+    for (const int exact_below : {100000, 10}) {  // exact, then approximate (randomised kd-trees)
+      MatchOptions options;
+      options.index = index;
+      options.exact_below = exact_below;
+      options.k = 2;
+      const DescriptorMatcher matcher(scene, scene_descriptors, options);
+      const std::vector<DescriptorMatch> matches = matcher.Match(object, object_descriptors);
+      ASSERT_EQ(matches.size(), 2 * object_descriptors.primitive.size());
+      int right = 0;
+      for (const DescriptorMatch& match : matches) {
+        if (match.rank != 0) continue;
+        EXPECT_EQ(scene[static_cast<size_t>(match.train)].type, object[static_cast<size_t>(match.query)].type);
+        right += match.train == match.query ? 1 : 0;
+      }
+      EXPECT_GT(right, 0.95 * static_cast<double>(object_descriptors.primitive.size()))
+          << "index " << static_cast<int>(index) << ", exact_below " << exact_below;
+      EXPECT_NEAR(ScoreCorrespondences(object, scene, matches, motion).Score(),
+                  static_cast<double>(right) / object_descriptors.primitive.size(), 1e-9);
     }
-    EXPECT_GT(right, 0.95 * static_cast<double>(object_descriptors.primitive.size())) << "exact_below " << exact_below;
-    EXPECT_NEAR(ScoreCorrespondences(object, scene, matches, motion).Score(),
-                static_cast<double>(right) / object_descriptors.primitive.size(), 1e-9);
   }
 }
 
@@ -418,24 +422,27 @@ TEST(EcvMatching, MatchingInPartsGivesTheSameMatchesInMatchOrder) {
     }
     return some;
   };
-  for (const bool structure_specific : {true, false}) {
-    MatchOptions options;
-    options.structure_specific = structure_specific;
-    options.k = 2;
-    const DescriptorMatcher matcher(scene, ComputeDescriptors(scene), options);  // approximate: > exact_below rows
-    const std::vector<DescriptorMatch> whole = matcher.Match(query, all);
-    std::vector<DescriptorMatch> merged = matcher.Match(query, part(rest));
-    const std::vector<DescriptorMatch> ranked = matcher.Match(query, part(first));
-    merged.insert(merged.end(), ranked.begin(), ranked.end());
-    std::stable_sort(merged.begin(), merged.end(), [&](const DescriptorMatch& a, const DescriptorMatch& b) {
-      return MatchOrderLess(query, structure_specific, a.query, b.query);
-    });
-    ASSERT_EQ(merged.size(), whole.size()) << "structure_specific " << structure_specific;
-    for (size_t i = 0; i < whole.size(); ++i) {
-      ASSERT_EQ(std::tie(merged[i].query, merged[i].train, merged[i].rank),
-                std::tie(whole[i].query, whole[i].train, whole[i].rank))
-          << "match " << i << ", structure_specific " << structure_specific;
-      ASSERT_EQ(merged[i].distance, whole[i].distance);
+  for (const MatchIndex index : {MatchIndex::kFlann, MatchIndex::kKdForest}) {
+    for (const bool structure_specific : {true, false}) {
+      MatchOptions options;
+      options.index = index;
+      options.structure_specific = structure_specific;
+      options.k = 2;
+      const DescriptorMatcher matcher(scene, ComputeDescriptors(scene), options);  // approximate: > exact_below rows
+      const std::vector<DescriptorMatch> whole = matcher.Match(query, all);
+      std::vector<DescriptorMatch> merged = matcher.Match(query, part(rest));
+      const std::vector<DescriptorMatch> ranked = matcher.Match(query, part(first));
+      merged.insert(merged.end(), ranked.begin(), ranked.end());
+      std::stable_sort(merged.begin(), merged.end(), [&](const DescriptorMatch& a, const DescriptorMatch& b) {
+        return MatchOrderLess(query, structure_specific, a.query, b.query);
+      });
+      ASSERT_EQ(merged.size(), whole.size()) << "structure_specific " << structure_specific;
+      for (size_t i = 0; i < whole.size(); ++i) {
+        ASSERT_EQ(std::tie(merged[i].query, merged[i].train, merged[i].rank),
+                  std::tie(whole[i].query, whole[i].train, whole[i].rank))
+            << "match " << i << ", index " << static_cast<int>(index) << ", structure_specific " << structure_specific;
+        ASSERT_EQ(merged[i].distance, whole[i].distance);
+      }
     }
   }
 }
