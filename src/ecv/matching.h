@@ -12,7 +12,7 @@ namespace ecv {
 /// The nearest-neighbour index a DescriptorMatcher searches.
 enum class MatchIndex {
   kFlann,     ///< OpenCV's FLANN: randomised kd-trees with a row per leaf (the paper's matcher)
-  kKdForest,  ///< ecvpose's KdForest: the same trees with leaves of leaf_size rows, about 3x faster per query
+  kKdForest,  ///< ecvpose's KdForest: the same trees with leaves of leaf_size rows, much less time per check
 };
 
 /// Nearest-neighbour matching of context descriptors.
