@@ -18,10 +18,12 @@ namespace ecv {
 // (OpenCV's) or a KdForest. OpenCV's copy of FLANN is used because its randomised kd-trees draw from seedable
 // generators; Debian's libflann shuffles them with std::random_device, so its matches differ from run to run.
 struct DescriptorMatcher::Index {
-  cv::Mat values;              // owned copy: FLANN keeps pointers into it
+  cv::Mat values;              // owned copy: FLANN keeps pointers into it (released once a KdForest copied it)
   std::vector<int> primitive;  // train primitive of each row
   std::unique_ptr<cv::flann::Index> flann;
   std::unique_ptr<KdForest> forest;
+
+  int rows() const { return forest ? forest->size() : values.rows; }
 };
 
 namespace {
@@ -67,6 +69,7 @@ DescriptorMatcher::DescriptorMatcher(const std::vector<Primitive>& train_primiti
       forest.trees = options_.trees;
       forest.leaf_size = options_.leaf_size;
       index->forest = std::make_unique<KdForest>(index->values, forest);
+      index->values.release();
     } else if (index->values.rows > 0) {
       // The trees draw from std::rand and OpenCV's generator: both seeded, under a lock, so that the same
       // descriptors always give the same trees (and the same matches).
@@ -93,7 +96,7 @@ std::vector<DescriptorMatch> DescriptorMatcher::Match(const std::vector<Primitiv
   std::vector<DescriptorMatch> matches;
   for (size_t type = 0; type < indices_.size(); ++type) {
     const Index& index = *indices_[type];
-    if (index.values.rows == 0) continue;
+    if (index.rows() == 0) continue;
     cv::Mat values;
     std::vector<int> primitive;
     SelectRows(
@@ -103,10 +106,10 @@ std::vector<DescriptorMatch> DescriptorMatcher::Match(const std::vector<Primitiv
         },
         &values, &primitive);
     if (values.rows == 0) continue;
-    const int k = std::min(options_.k, index.values.rows);
+    const int k = std::min(options_.k, index.rows());
     cv::Mat neighbours, squared;
     if (index.forest) {
-      const int checks = index.values.rows < options_.exact_below ? index.values.rows : options_.checks;
+      const int checks = index.rows() < options_.exact_below ? index.rows() : options_.checks;
       index.forest->Search(values, k, checks, &neighbours, &squared);
     } else {
       index.flann->knnSearch(values, neighbours, squared, k, cv::flann::SearchParams(options_.checks));
