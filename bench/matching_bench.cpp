@@ -60,7 +60,8 @@ std::vector<Matcher> Matchers() {
   return matchers;
 }
 
-// Every library view's ranking rows (seeded, as the recognizer picks them), as one query set.
+// A seeded random 200 rows of every library view, as one query set: as many as the ranking takes, though not
+// the same rows (the recognizer draws them per view and seed).
 std::pair<std::vector<Primitive>, Descriptors> RankingQueries(const ModelLibrary& library) {
   std::vector<Primitive> primitives;
   Descriptors queries;

@@ -173,7 +173,6 @@ RansacOptions RecognizerOptions::DefaultRansac() {
 
 MatchOptions RecognizerOptions::DefaultMatch() {
   MatchOptions options;
-  options.checks = 32;
   // A frame's segments (900-1300 on YCB-Video) fell under MatchOptions' 1000 and were searched linearly, at
   // about 13 us per query against 7 us in the kd-trees. On the 30 YCB-Video frames (seeds 1/2/3): match 890-940
   // -> 550-590 ms per frame (median), 46/44/44 of 70 objects found against 49/43/44, and view ranking as good

@@ -112,7 +112,7 @@ struct KdForest::Builder {
   }
 };
 
-KdForest::KdForest(const cv::Mat& rows, const KdForestOptions& options) : leaf_size_(options.leaf_size) {
+KdForest::KdForest(const cv::Mat& rows, const KdForestOptions& options) {
   options.Check();
   if (rows.type() != CV_32FC1) ThrowInputError("kd-forest rows", "type", "CV_32FC1");
   rows_ = rows.clone();
@@ -122,8 +122,8 @@ KdForest::KdForest(const cv::Mat& rows, const KdForestOptions& options) : leaf_s
     std::iota(order.begin(), order.end(), 0);
     std::shuffle(order.begin(), order.end(), random);
     std::vector<Node>& nodes = nodes_.emplace_back();
-    nodes.reserve(2 * order.size() / static_cast<size_t>(leaf_size_) + 1);
-    if (!order.empty()) Builder{rows_, leaf_size_, nodes, order, std::mt19937_64(random())}.Split(0, rows_.rows);
+    nodes.reserve(2 * order.size() / static_cast<size_t>(options.leaf_size) + 1);
+    if (!order.empty()) Builder{rows_, options.leaf_size, nodes, order, std::mt19937_64(random())}.Split(0, rows_.rows);
   }
 }
 

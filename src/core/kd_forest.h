@@ -49,7 +49,6 @@ class KdForest {
   struct Searcher;  // searches for one query at a time (kd_forest.cpp)
 
   cv::Mat rows_;
-  int leaf_size_ = 1;
   std::vector<std::vector<Node>> nodes_;  // per tree
   std::vector<std::vector<int>> order_;   // per tree, the rows grouped by leaf
 };
