@@ -141,11 +141,15 @@ TEST(Ransac, SameSeedSameResult) {
   options.max_iterations = 3000;
   options.expected_inlier_ratio = 0.15;
   const RansacResult first = EstimatePoseRansac(problem.object, problem.scene, problem.correspondences, options);
+  options.seed = 2;  // each thread keeps the seeded generators of its last seed: they must follow the seed
+  const RansacResult other = EstimatePoseRansac(problem.object, problem.scene, problem.correspondences, options);
+  options.seed = 1;
   const RansacResult second = EstimatePoseRansac(problem.object, problem.scene, problem.correspondences, options);
   ASSERT_TRUE(first.success);
   EXPECT_EQ(first.scene_from_object.matrix(), second.scene_from_object.matrix());
   EXPECT_EQ(first.rejected_by_polygon, second.rejected_by_polygon);
   EXPECT_EQ(first.fit_error_m, second.fit_error_m);
+  EXPECT_NE(first.rejected_by_polygon, other.rejected_by_polygon);
 }
 
 // The support test (min_support, min_support_share) drops the poses of wrong samples before their inliers are
