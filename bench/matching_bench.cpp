@@ -85,16 +85,11 @@ std::pair<std::vector<Primitive>, Descriptors> RankingQueries(const ModelLibrary
 
 // The scene's primitives and descriptors as the recognizer makes them (its neighbour and descriptor caps).
 std::pair<std::vector<Primitive>, Descriptors> SceneDescriptors(const ModelLibrary& library, const RgbdFrame& frame) {
-  const RecognizerOptions options;
   const FeatureSettings& settings = library.feature_settings();
   std::vector<Primitive> primitives = ExtractPrimitives(frame, settings.ecv).primitives;
-  DescriptorOptions describe = settings.descriptor;
-  if (describe.max_neighbours == 0 || describe.max_neighbours > options.scene_max_neighbours) {
-    describe.max_neighbours = options.scene_max_neighbours;
-  }
-  const size_t most = static_cast<size_t>(options.scene_max_descriptors);
-  const int step = primitives.size() > most ? static_cast<int>((primitives.size() + most - 1) / most) : 1;
-  Descriptors descriptors = ComputeDescriptors(primitives, describe, 1, step);
+  RecognizerOptions options;
+  options.ransac.threads = 1;
+  Descriptors descriptors = ComputeSceneDescriptors(primitives, settings.descriptor, options);
   return {std::move(primitives), std::move(descriptors)};
 }
 

@@ -424,14 +424,7 @@ class Recognizer::Impl {
     result->timings_ms["extract"] = MillisecondsSince(stage);
 
     stage = Clock::now();
-    DescriptorOptions describe = settings.descriptor;
-    if (options_.scene_max_neighbours > 0 &&
-        (describe.max_neighbours == 0 || describe.max_neighbours > options_.scene_max_neighbours)) {
-      describe.max_neighbours = options_.scene_max_neighbours;
-    }
-    const size_t count = scene->primitives.size(), most = static_cast<size_t>(options_.scene_max_descriptors);
-    const int source_step = most > 0 && count > most ? static_cast<int>((count + most - 1) / most) : 1;
-    scene->descriptors = ComputeDescriptors(scene->primitives, describe, options_.ransac.threads, source_step);
+    scene->descriptors = ComputeSceneDescriptors(scene->primitives, settings.descriptor, options_);
     if (scene->descriptors.values.rows > 0) {
       scene->matcher = std::make_unique<DescriptorMatcher>(scene->primitives, scene->descriptors, options_.match);
     }
@@ -853,6 +846,18 @@ std::vector<Detection> DetectionsFromJson(const nlohmann::json& json, const std:
     detections.push_back(detection);
   }
   return detections;
+}
+
+Descriptors ComputeSceneDescriptors(const std::vector<Primitive>& primitives, const DescriptorOptions& descriptor,
+                                    const RecognizerOptions& options) {
+  DescriptorOptions describe = descriptor;
+  if (options.scene_max_neighbours > 0 &&
+      (describe.max_neighbours == 0 || describe.max_neighbours > options.scene_max_neighbours)) {
+    describe.max_neighbours = options.scene_max_neighbours;
+  }
+  const size_t count = primitives.size(), most = static_cast<size_t>(options.scene_max_descriptors);
+  const int source_step = most > 0 && count > most ? static_cast<int>((count + most - 1) / most) : 1;
+  return ComputeDescriptors(primitives, describe, options.ransac.threads, source_step);
 }
 
 }  // namespace ecv

@@ -206,6 +206,12 @@ nlohmann::json RecognitionToJson(const RecognitionResult& result);
 /// field when one is missing or malformed.
 std::vector<Detection> DetectionsFromJson(const nlohmann::json& json, const std::string& source);
 
+/// A frame's descriptors as the recognizer computes them from its `primitives`: the library's `descriptor`
+/// settings with at most options.scene_max_neighbours neighbours per context, and every n-th primitive a source
+/// so that at most options.scene_max_descriptors are described; on options.ransac.threads threads.
+Descriptors ComputeSceneDescriptors(const std::vector<Primitive>& primitives, const DescriptorOptions& descriptor,
+                                    const RecognizerOptions& options);
+
 /// What a tracking frame (Recognizer::Recognize with priors) searches for, by view ranking and RANSAC, besides
 /// following its priors.
 enum class SearchScope {
