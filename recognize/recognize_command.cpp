@@ -78,9 +78,10 @@ void PrintDetections(const LoadedFrame& loaded, const RecognitionResult& result)
             << " detections (" << result.scene_primitives << " scene primitives)\n";
   for (const Detection& d : result.detections) {
     std::cout << "  " << std::left << std::setw(24) << d.model << std::right << " score " << d.score << " (depth "
-              << d.depth_agreement << ", colour " << d.color_agreement << ", fit " << std::setprecision(1)
-              << 1000.0 * d.surface_error_m << " mm" << std::setprecision(2) << ", outline " << d.contour_agreement
-              << "), inliers " << d.inlier_fraction << ", view " << d.view << ", t = [" << std::setprecision(3)
+              << d.depth_agreement << ", colour " << d.color_agreement << ", edges " << d.edge_agreement << " of "
+              << d.edge_pixels << ", fit " << std::setprecision(1) << 1000.0 * d.surface_error_m << " mm"
+              << std::setprecision(2) << ", outline " << d.contour_agreement << "), inliers " << d.inlier_fraction
+              << ", view " << d.view << ", t = [" << std::setprecision(3)
               << d.camera_from_object.translation().transpose() << "] m" << std::setprecision(2) << '\n';
     for (const GroundTruth& truth : loaded.ground_truth) {
       if (truth.object_name != d.model) continue;
@@ -259,6 +260,11 @@ CommandAction SetupRecognizeCommand(CLI::App& command) {
       "--no-contour", [&options = args->options](int64_t) { options.contour_falloff = 0.0; },
       "Verify without the contour factor (a pose's outline on the scene's depth steps): for flat objects thinner\n"
       "than 1 cm lying on a surface, or parts packed flush in a tray");
+  command
+      .add_option("--edge-weight", options.edge_weight,
+                  "Weight of the texture edges against the colour correlation in verification (0: colour alone)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
   command.add_flag("--fast-icp", options.projective_icp,
                    "ICP pairs points along the camera's rays (7x faster refinement, finds fewer objects)");
   command.footer(

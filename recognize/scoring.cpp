@@ -174,6 +174,55 @@ double ContourFactor(const OutlineOnSteps& outline, double free, double falloff,
   return std::clamp(1.0 - (free - outline.Share()) / falloff, 0.0, 1.0);
 }
 
+cv::Mat GreyGradient(const cv::Mat& grey) {
+  if (grey.type() != CV_8UC1) ThrowInputError("grey gradient", "grey", "a CV_8UC1 image");
+  cv::Mat du, dv, gradient;
+  cv::Sobel(grey, du, CV_32F, 1, 0, 3);
+  cv::Sobel(grey, dv, CV_32F, 0, 1, 3);
+  cv::merge(std::vector<cv::Mat>{du, dv}, gradient);
+  return gradient;
+}
+
+void EdgeOptions::Check() const {
+  auto require = [](bool ok, const char* field, const char* expected) {
+    if (!ok) ThrowInputError("edge options", field, expected);
+  };
+  require(strong > 0.0, "strong", "> 0");
+  require(weak >= 0.0, "weak", ">= 0");
+  require(min_cos >= 0.0 && min_cos <= 1.0, "min_cos", "in [0, 1]");
+}
+
+EdgeAgreement CompareEdges(const cv::Mat& model_gradient, const cv::Mat& scene_gradient,
+                           const std::vector<cv::Point>& pixels, const EdgeOptions& options) {
+  options.Check();
+  if (model_gradient.type() != CV_32FC2 || scene_gradient.type() != CV_32FC2 ||
+      model_gradient.size() != scene_gradient.size()) {
+    ThrowInputError("compare edges", "model_gradient/scene_gradient", "CV_32FC2 images of one size");
+  }
+  const cv::Rect image(cv::Point(0, 0), model_gradient.size());
+  const auto strong = static_cast<float>(options.strong), weak = static_cast<float>(options.weak);
+  const auto min_cos = static_cast<float>(options.min_cos);
+  EdgeAgreement agreement;
+  for (const cv::Point& p : pixels) {
+    if (!image.contains(p)) ThrowInputError("compare edges", "pixels", "pixels inside the gradient images");
+    const cv::Vec2f& m = model_gradient.at<cv::Vec2f>(p);
+    const float model_norm = std::hypot(m[0], m[1]);
+    if (model_norm < strong) continue;
+    ++agreement.predicted;
+    const cv::Vec2f& s = scene_gradient.at<cv::Vec2f>(p);
+    const float scene_norm = std::hypot(s[0], s[1]);
+    if (scene_norm >= weak && std::abs(m[0] * s[0] + m[1] * s[1]) >= min_cos * model_norm * scene_norm) {
+      ++agreement.shown;
+    }
+  }
+  return agreement;
+}
+
+double Appearance(double color, const EdgeAgreement& edges, double weight, int min_edges) {
+  if (weight <= 0.0 || edges.predicted < std::max(1, min_edges)) return color;
+  return std::pow(std::max(0.0, color), 1.0 - weight) * std::pow(edges.Share(), weight);
+}
+
 // Normalised cross-correlation of (model, scene) colour pairs: the smaller of two. Per channel (averaged), it
 // ignores each channel's gain and offset: a white balance, a colour cast. Over all channels at once (one gain and
 // one offset), it keeps the hue: per channel alone, a red label and a blue one with the same light-dark pattern

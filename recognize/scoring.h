@@ -80,6 +80,40 @@ OutlineOnSteps OutlineOnDepthSteps(const cv::Mat& rendered_depth, int stride, co
 /// steps, falling linearly to 0 over `falloff` below; `falloff` 0: always 1.
 double ContourFactor(const OutlineOnSteps& outline, double free, double falloff, int min_seen);
 
+/// Image gradients of a grey image (CV_8UC1): 3x3 Sobel, CV_32FC2 (d/du, d/dv). Throws InputError on another type.
+cv::Mat GreyGradient(const cv::Mat& grey);
+
+/// What counts as a texture edge and as the same edge in CompareEdges, in 3x3 Sobel units (a step of h grey
+/// levels gives up to 4h).
+struct EdgeOptions {
+  double strong = 60.0;  ///< the model shows an edge: gradient magnitude at least this
+  double weak = 20.0;    ///< the scene shows it: gradient magnitude at least this (lower: its contrast may be less) ...
+  double min_cos = 0.9;  ///< ... at the same orientation: |cos| of the angle between the gradients at least this
+
+  /// Throws InputError on values outside their ranges.
+  void Check() const;
+};
+
+/// A posed model's texture edges and how many of them the scene shows.
+struct EdgeAgreement {
+  int predicted = 0;  ///< strong gradients of the rendered model
+  int shown = 0;      ///< ... where the scene has a weak one at the same orientation
+  double Share() const { return predicted > 0 ? static_cast<double>(shown) / predicted : 0.0; }
+};
+
+/// The model's texture edges on `pixels` (where its rendered surface lies on the scene's, away from its outline) and
+/// those the scene shows: `model_gradient` and `scene_gradient` (GreyGradient, same size) at the same pixel. A pose
+/// turned 180 degrees puts printed text where the scene shows a plain side, or the reverse, and most of its edges
+/// find no partner, while the colours on a small patch may still correlate. Throws InputError when the images do
+/// not fit.
+EdgeAgreement CompareEdges(const cv::Mat& model_gradient, const cv::Mat& scene_gradient,
+                           const std::vector<cv::Point>& pixels, const EdgeOptions& options = {});
+
+/// Verification's appearance term: `color` (ColorCorrelation) to the power 1 - `weight` times edges.Share() to the
+/// power `weight`; `color` alone when fewer than `min_edges` edges are predicted (a plain surface: too few to
+/// tell) or `weight` is 0.
+double Appearance(double color, const EdgeAgreement& edges, double weight, int min_edges);
+
 /// Normalised cross-correlation of (model, scene) colour pairs in [0, 1]; 0 for fewer than 10 pairs. High when
 /// the model's texture lies where the scene shows it, whatever the brightness and white balance of the light:
 /// the smaller of the correlation per channel (averaged; each channel's own gain and offset) and the

@@ -374,6 +374,18 @@ TEST(RecognizerOptions, OutOfRangeValuesAreReportedByName) {
   options = RecognizerOptions();
   options.good_enough_score = -0.1;
   EXPECT_NE(message(options).find("good_enough_score"), std::string::npos) << message(options);
+  options = RecognizerOptions();
+  options.edge_weight = 1.2;
+  EXPECT_NE(message(options).find("edge_weight"), std::string::npos) << message(options);
+  options = RecognizerOptions();
+  options.min_edge_pixels = 0;
+  EXPECT_NE(message(options).find("min_edge_pixels"), std::string::npos) << message(options);
+  options = RecognizerOptions();
+  options.edge.weak = -1.0;
+  EXPECT_NE(message(options).find("weak"), std::string::npos) << message(options);
+  options = RecognizerOptions();
+  options.rival_min_ratio = -0.5;
+  EXPECT_NE(message(options).find("rival_min_ratio"), std::string::npos) << message(options);
 }
 
 // The scene's descriptors (ComputeSceneDescriptors) keep the library's settings but for the two caps: every n-th

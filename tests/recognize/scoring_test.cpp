@@ -1,6 +1,6 @@
 // The recognizer's scores on constructed data: the consistent-set size of planted true correspondences
 // among false ones, the colour correlation's invariance to gain and offset, and how much of a pose's outline
-// runs along the scene's depth steps.
+// runs along the scene's depth steps, and how many of a model's texture edges the scene shows.
 
 #include <cmath>
 #include <random>
@@ -278,6 +278,68 @@ TEST(ContourFactor, OneFromTheFreeShareZeroBelowTheFalloffAndOneWhenTooLittleOut
   EXPECT_DOUBLE_EQ(ContourFactor({19, 0}, 0.3, 0.2, 20), 1.0);  // too little outline to tell
   EXPECT_DOUBLE_EQ(ContourFactor({0, 0}, 0.3, 0.2, 20), 1.0);
   EXPECT_DOUBLE_EQ(ContourFactor({100, 0}, 0.3, 0.0, 20), 1.0);  // no factor
+}
+
+// A grey image of `size` with a step from `low` to `high` grey levels at column (vertical: row) `at`.
+cv::Mat Step(cv::Size size, int at, int low, int high, bool vertical = false) {
+  cv::Mat image(size, CV_8UC1, cv::Scalar(low));
+  if (vertical) {
+    image.rowRange(at, size.height).setTo(high);
+  } else {
+    image.colRange(at, size.width).setTo(high);
+  }
+  return image;
+}
+
+std::vector<cv::Point> AllPixels(cv::Size size) {
+  std::vector<cv::Point> pixels;
+  for (int v = 0; v < size.height; ++v) {
+    for (int u = 0; u < size.width; ++u) pixels.emplace_back(u, v);
+  }
+  return pixels;
+}
+
+TEST(CompareEdges, CountsTheModelsEdgePixelsAndFindsThemInTheSameStepOfAnyContrastOrSign) {
+  const cv::Size size(20, 20);
+  const cv::Mat model = GreyGradient(Step(size, 10, 50, 150));
+  // A step of 100 grey levels gives |Sobel| 400 on the two columns beside it, 20 rows each, and 0 elsewhere.
+  const EdgeAgreement same = CompareEdges(model, model, AllPixels(size));
+  EXPECT_EQ(same.predicted, 40);
+  EXPECT_EQ(same.shown, 40);
+  EXPECT_DOUBLE_EQ(same.Share(), 1.0);
+  // The scene's step is fainter (|Sobel| 4 x 10 = 40 >= weak 20) and dark to bright the other way: still shown.
+  EXPECT_EQ(CompareEdges(model, GreyGradient(Step(size, 10, 120, 110)), AllPixels(size)).shown, 40);
+  // Too faint (|Sobel| 4 x 4 = 16 < 20), one column off (the step's other column only), across it, or no step.
+  EXPECT_EQ(CompareEdges(model, GreyGradient(Step(size, 10, 100, 104)), AllPixels(size)).shown, 0);
+  EXPECT_EQ(CompareEdges(model, GreyGradient(Step(size, 11, 50, 150)), AllPixels(size)).shown, 20);
+  EXPECT_EQ(CompareEdges(model, GreyGradient(Step(size, 10, 50, 150, true)), AllPixels(size)).shown, 0);
+  EXPECT_EQ(CompareEdges(model, GreyGradient(Step(size, 10, 90, 90)), AllPixels(size)).shown, 0);
+  // Only the given pixels count: the left column of the step.
+  std::vector<cv::Point> left;
+  for (int v = 0; v < size.height; ++v) left.emplace_back(9, v);
+  EXPECT_EQ(CompareEdges(model, model, left).predicted, 20);
+  // A model step below `strong` predicts nothing.
+  EXPECT_EQ(CompareEdges(GreyGradient(Step(size, 10, 100, 110)), model, AllPixels(size)).predicted, 0);
+}
+
+TEST(CompareEdges, RejectsImagesThatDoNotFitAndPixelsOutside) {
+  const cv::Mat gradient = GreyGradient(Step(cv::Size(20, 20), 10, 50, 150));
+  EXPECT_THROW(CompareEdges(gradient, GreyGradient(Step(cv::Size(21, 20), 10, 50, 150)), {}), InputError);
+  EXPECT_THROW(CompareEdges(gradient, cv::Mat(20, 20, CV_32FC1, cv::Scalar(0)), {}), InputError);
+  EXPECT_THROW(CompareEdges(gradient, gradient, {cv::Point(20, 3)}), InputError);
+  EXPECT_THROW(GreyGradient(cv::Mat(4, 4, CV_8UC3)), InputError);
+  EdgeOptions options;
+  options.min_cos = 1.5;
+  EXPECT_THROW(CompareEdges(gradient, gradient, {}, options), InputError);
+}
+
+TEST(Appearance, WeighsColourAndEdgesWhenEnoughEdgesArePredicted) {
+  const EdgeAgreement edges{100, 25};  // a quarter of 100 predicted edges shown
+  EXPECT_DOUBLE_EQ(Appearance(0.64, edges, 0.5, 50), std::sqrt(0.64 * 0.25));
+  EXPECT_DOUBLE_EQ(Appearance(0.64, edges, 1.0, 50), 0.25);
+  EXPECT_DOUBLE_EQ(Appearance(0.64, edges, 0.0, 50), 0.64);   // no weight: colour alone
+  EXPECT_DOUBLE_EQ(Appearance(0.64, edges, 0.5, 101), 0.64);  // too few edges to tell: colour alone
+  EXPECT_DOUBLE_EQ(Appearance(0.64, EdgeAgreement{}, 0.5, 0), 0.64);
 }
 
 }  // namespace
