@@ -17,6 +17,7 @@
 #include "recognize/evaluation.h"
 #include "recognize/recognizer.h"
 #include "support/test_data.h"
+#include "verify_prior.h"
 
 namespace ecv {
 namespace {
@@ -235,13 +236,7 @@ TEST_F(RecognizeEndToEnd, APoseAFewMillimetresOffTheSurfaceScoresZeroThroughItsR
   options.min_score = 0.0;
   options.min_visible_fraction = 0.0;
   auto verify = [&](const RecognizerOptions& settings, const Eigen::Isometry3d& pose) {
-    Detection prior;
-    prior.model = "003_cracker_box";
-    prior.camera_from_object = pose;
-    prior.tracked = true;
-    const RecognitionResult result = Recognizer(library, settings).Recognize(frame.rgbd, {prior});
-    EXPECT_EQ(result.detections.size(), 1U);
-    return result.detections.empty() ? Detection() : result.detections[0];
+    return test::VerifyPrior(library, settings, frame.rgbd, "003_cracker_box", pose);
   };
   const Detection right = verify(options, truth->camera_from_object);
   EXPECT_LT(right.surface_error_m, options.residual_free_m);

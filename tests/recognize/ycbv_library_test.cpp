@@ -16,6 +16,7 @@
 #include "recognize/evaluation.h"
 #include "recognize/recognizer.h"
 #include "support/test_data.h"
+#include "verify_prior.h"
 
 namespace ecv {
 namespace {
@@ -178,15 +179,8 @@ TEST_F(YcbvLibrary, TheMustardBottleTurnedToItsPrintedSideLosesThroughItsTexture
   RecognizerOptions options;
   options.min_score = 0.0;  // report the prior with its score
   options.min_visible_fraction = 0.0;
-  // The prior, verified, refined by ICP and verified again, as a tracked object is.
   auto verified = [&](const RecognizerOptions& settings, const Eigen::Isometry3d& pose) {
-    Detection prior;
-    prior.model = "006_mustard_bottle";
-    prior.camera_from_object = pose;
-    prior.tracked = true;
-    const std::vector<Detection> found = Recognizer(library, settings).Recognize(frame.rgbd, {prior}).detections;
-    EXPECT_EQ(found.size(), 1U);
-    return found.empty() ? Detection() : found[0];
+    return test::VerifyPrior(library, settings, frame.rgbd, "006_mustard_bottle", pose);
   };
   const Detection right_scored = verified(options, right.camera_from_object);
   const Detection turned_scored = verified(options, turned);
