@@ -265,6 +265,10 @@ CommandAction SetupRecognizeCommand(CLI::App& command) {
                   "Weight of the texture edges against the colour correlation in verification (0: colour alone)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
+  command.add_flag(
+      "--nearest-inliers", [&options = args->options](int64_t) { options.projective_inliers = false; },
+      "RANSAC finds an object point's inlier partner by a search among the scene's points in 3D (the paper)\n"
+      "instead of among the depth samples around where the point is seen");
   command.add_flag("--fast-icp", options.projective_icp,
                    "ICP pairs points along the camera's rays (7x faster refinement, finds fewer objects)");
   command.footer(

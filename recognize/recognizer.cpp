@@ -38,13 +38,15 @@ struct Scene {
   std::vector<Primitive> primitives;
   Descriptors descriptors;
   std::unique_ptr<DescriptorMatcher> matcher;
-  std::vector<Eigen::Vector3f> points;         // the depth points at dense_stride_px, for ICP
-  std::vector<Eigen::Vector3f> ransac_points;  // primitive positions first, then the depth points at ransac_stride_px
-  std::unique_ptr<RadiusGrid> ransac_grid;     // over ransac_points, radius the inlier threshold: built once
-  cv::Mat color;                               // the frame's colours, as verification compares them
-  cv::Mat depth_steps;                         // DepthSteps of the frame, for verification's contour factor
-  cv::Mat gradient;                            // GreyGradient of `color` at dense_stride_px, for the edge factor
-  OrganizedScene organized;                    // the depth samples with normals, for projective ICP
+  std::vector<Eigen::Vector3f> points;  // the depth points at dense_stride_px, for ICP
+  // Primitive positions first, then (unless projective_inliers) the depth points at ransac_stride_px and a grid
+  // over all of them with the inlier threshold as radius, built once per frame.
+  std::vector<Eigen::Vector3f> ransac_points;
+  std::unique_ptr<RadiusGrid> ransac_grid;
+  cv::Mat color;             // the frame's colours, as verification compares them
+  cv::Mat depth_steps;       // DepthSteps of the frame, for verification's contour factor
+  cv::Mat gradient;          // GreyGradient of `color` at dense_stride_px, for the edge factor
+  OrganizedScene organized;  // the depth samples with normals, for projective ICP
   SceneVisibility visibility;
 };
 
@@ -430,10 +432,12 @@ class Recognizer::Impl {
     result->scene_primitives = static_cast<int>(scene->primitives.size());
     const std::vector<Eigen::Vector3f> positions = PrimitivePositions(scene->primitives);
     scene->ransac_points = positions;
-    const std::vector<Eigen::Vector3f> depth_points = DepthPoints(frame, options_.ransac_stride_px);
-    scene->ransac_points.insert(scene->ransac_points.end(), depth_points.begin(), depth_points.end());
-    scene->ransac_grid =
-        std::make_unique<RadiusGrid>(scene->ransac_points, static_cast<float>(options_.ransac.inlier_threshold_m));
+    if (!options_.projective_inliers) {
+      const std::vector<Eigen::Vector3f> depth_points = DepthPoints(frame, options_.ransac_stride_px);
+      scene->ransac_points.insert(scene->ransac_points.end(), depth_points.begin(), depth_points.end());
+      scene->ransac_grid =
+          std::make_unique<RadiusGrid>(scene->ransac_points, static_cast<float>(options_.ransac.inlier_threshold_m));
+    }
     result->timings_ms["extract"] = MillisecondsSince(stage);
 
     stage = Clock::now();
@@ -581,9 +585,16 @@ class Recognizer::Impl {
     ransac.sample_radius_m = options_.sample_radius_diameters * record.diameter_m;
     Hypothesis hypothesis;
     hypothesis.view = candidate->view;
-    hypothesis.ransac = EstimatePoseRansac(
-        PrimitivePositions(record.views[static_cast<size_t>(candidate->view)].primitives), scene.ransac_points,
-        *scene.ransac_grid, candidate->correspondences, ransac, &scene.visibility);
+    const std::vector<Eigen::Vector3f> object_points =
+        PrimitivePositions(record.views[static_cast<size_t>(candidate->view)].primitives);
+    if (scene.ransac_grid) {
+      hypothesis.ransac = EstimatePoseRansac(object_points, scene.ransac_points, *scene.ransac_grid,
+                                             candidate->correspondences, ransac, &scene.visibility);
+    } else {
+      ransac.projective_stride_px = options_.ransac_stride_px;
+      hypothesis.ransac =
+          EstimatePoseRansac(object_points, scene.ransac_points, candidate->correspondences, ransac, &scene.visibility);
+    }
     hypothesis.pose = hypothesis.ransac.scene_from_object;
     (*timings_ms)["ransac"] += MillisecondsSince(stage);
     if (!hypothesis.ransac.success) return;

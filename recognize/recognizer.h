@@ -72,13 +72,19 @@ struct RecognizerOptions {
   /// many model diameters (RansacOptions::sample_radius_m); 0 draws them anywhere in the scene.
   double sample_radius_diameters = 1.0;
   int dense_stride_px = 2;  ///< scene depth points for ICP and verification: every n-th pixel
-  /// Scene depth points for RANSAC's inlier count (with the primitives): every n-th pixel. An inlier needs a
+  /// Scene depth samples for RANSAC's inlier count (see projective_inliers): every n-th pixel. An inlier needs a
   /// scene point within 1 cm; points 4 px apart (about 4 mm at 1 m) still show that, with a quarter of the
   /// points to search. On the 30 YCB-Video frames (seeds 1/2/3, with every 4th of the stride-2 points): 46/42/46
   /// of 70 objects against 49/43/44 at stride 2, RANSAC 455-595 instead of 550-600 ms per frame (median; two runs
   /// at a time on 2 cores); with approximate search from 100 descriptors as well (DefaultMatch), 47/43/44 and
   /// 330-380 ms.
   int ransac_stride_px = 4;
+  /// RANSAC looks for an object point's inlier partner among the 3 x 3 depth samples ransac_stride_px apart
+  /// around the pixel it projects to (RansacOptions::projective_stride_px) instead of the nearest of the depth
+  /// points and primitives in 3D (false, `recognize --nearest-inliers`). On the 30 YCB-Video frames (seeds
+  /// 1 / 2 / 3) the same 61 / 59 / 59 of 70 objects with the same 1 / 2 / 2 false positives; see bench/RESULTS.md
+  /// (session 26) for the time.
+  bool projective_inliers = true;
   bool refine = true;  ///< point-to-plane ICP of accepted poses against the scene
   /// ICP takes the model's surface as rendered at the pose (every dense_stride_px-th pixel), at most this many
   /// points of it (every n-th); a close-up renders tens of thousands. 0: all. On the 30 YCB-Video frames (with

@@ -70,6 +70,33 @@ bool Visible(const SceneVisibility& visibility, const Eigen::Vector3f& point_cam
   return depth > 0.0F && point_camera.z() <= depth + static_cast<float>(visibility.occlusion_margin_m);
 }
 
+// The nearest of the 3 x 3 depth samples `stride` pixels apart around the pixel where `point` (camera frame, in
+// front of the camera) is seen, and its squared distance; false when none has a measurement.
+bool NearestDepthSample(const SceneVisibility& visibility, int stride, const Eigen::Vector3f& point,
+                        Eigen::Vector3f* nearest, float* squared) {
+  const PinholeCamera& camera = visibility.camera;
+  const float fx = static_cast<float>(camera.fx), fy = static_cast<float>(camera.fy);
+  const float cx = static_cast<float>(camera.cx), cy = static_cast<float>(camera.cy);
+  const int centre_u = static_cast<int>(std::lround(fx * point.x() / point.z() + cx));
+  const int centre_v = static_cast<int>(std::lround(fy * point.y() / point.z() + cy));
+  *squared = std::numeric_limits<float>::infinity();
+  for (int v = centre_v - stride; v <= centre_v + stride; v += stride) {
+    if (v < 0 || v >= visibility.depth.rows) continue;
+    const float* row = visibility.depth.ptr<float>(v);
+    for (int u = centre_u - stride; u <= centre_u + stride; u += stride) {
+      if (u < 0 || u >= visibility.depth.cols || row[u] <= 0.0F) continue;
+      const float z = row[u];
+      const Eigen::Vector3f sample((static_cast<float>(u) - cx) * z / fx, (static_cast<float>(v) - cy) * z / fy, z);
+      const float distance = (sample - point).squaredNorm();
+      if (distance < *squared) {
+        *squared = distance;
+        *nearest = sample;
+      }
+    }
+  }
+  return std::isfinite(*squared);
+}
+
 // Object points within eps of their nearest scene point under a pose, with those scene points.
 struct Inliers {
   std::vector<Eigen::Vector3f> object, scene;
@@ -88,7 +115,7 @@ double MeanPairDistance(const Eigen::Isometry3d& pose, const Inliers& inliers) {
 class Estimator {
  public:
   Estimator(const std::vector<Eigen::Vector3f>& object_points, const std::vector<Eigen::Vector3f>& scene_points,
-            const RadiusGrid& scene_grid, const std::vector<Correspondence>& correspondences,
+            const RadiusGrid* scene_grid, const std::vector<Correspondence>& correspondences,
             const RansacOptions& options, const SceneVisibility* visibility)
       : object_(object_points),
         scene_(scene_points),
@@ -260,10 +287,11 @@ class Estimator {
         if (static_cast<double>(inliers->object.size()) < fraction * k - spread * std::sqrt(k)) return false;
       }
       ++checked;
-      const auto [nearest, squared] = tree_.NearestWithin(moved);
-      if (squared > eps_squared) continue;
+      Eigen::Vector3f partner;
+      float squared = 0.0F;
+      if (!Partner(moved, &partner, &squared) || squared > eps_squared) continue;
       inliers->object.push_back(point);
-      inliers->scene.push_back(scene_[static_cast<size_t>(nearest)]);
+      inliers->scene.push_back(partner);
       inliers->distance_sum += std::sqrt(squared);
     }
     inliers->visible = checked;
@@ -276,12 +304,25 @@ class Estimator {
     return inliers->object.size() >= required;
   }
 
+  // The scene point nearest `moved` (an object point under a pose) where options_.projective_stride_px says to look.
+  bool Partner(const Eigen::Vector3f& moved, Eigen::Vector3f* partner, float* squared) const {
+    if (options_.projective_stride_px > 0) {
+      return moved.z() > 0.0F &&
+             NearestDepthSample(*visibility_, options_.projective_stride_px, moved, partner, squared);
+    }
+    const auto [nearest, distance] = tree_->NearestWithin(moved);
+    if (nearest < 0) return false;
+    *partner = scene_[static_cast<size_t>(nearest)];
+    *squared = distance;
+    return true;
+  }
+
   const std::vector<Eigen::Vector3f>& object_;
   const std::vector<Eigen::Vector3f>& scene_;
   const std::vector<Correspondence>& correspondences_;
   const RansacOptions& options_;
   const SceneVisibility* visibility_;
-  const RadiusGrid& tree_;
+  const RadiusGrid* tree_;                    // null when options_.projective_stride_px > 0
   size_t required_agreeing_ = 0;              // correspondences that must agree with a sample's pose (0: no test)
   std::vector<int> order_;                    // object points in a fixed random order, for the preverification
   std::vector<std::vector<int>> neighbours_;  // per correspondence, when sampling is local (sample_radius_m)
@@ -304,6 +345,7 @@ void RansacOptions::Check() const {
   require(threads >= 1, "threads", "at least 1");
   require(min_support >= 0, "min_support", ">= 0 (0: no test)");
   require(min_support_share >= 0.0 && min_support_share <= 1.0, "min_support_share", "in [0, 1] (0: no test)");
+  require(projective_stride_px >= 0, "projective_stride_px", ">= 0 (0: the nearest scene point)");
 }
 
 int RansacOptions::Iterations() const {
@@ -336,24 +378,16 @@ void SceneVisibility::Check() const {
   }
 }
 
-RansacResult EstimatePoseRansac(const std::vector<Eigen::Vector3f>& object_points,
-                                const std::vector<Eigen::Vector3f>& scene_points,
-                                const std::vector<Correspondence>& correspondences, const RansacOptions& options,
-                                const SceneVisibility* visibility) {
-  const RadiusGrid scene_grid(scene_points, static_cast<float>(options.inlier_threshold_m));
-  return EstimatePoseRansac(object_points, scene_points, scene_grid, correspondences, options, visibility);
-}
+namespace {
 
-RansacResult EstimatePoseRansac(const std::vector<Eigen::Vector3f>& object_points,
-                                const std::vector<Eigen::Vector3f>& scene_points, const RadiusGrid& scene_grid,
-                                const std::vector<Correspondence>& correspondences, const RansacOptions& options,
-                                const SceneVisibility* visibility) {
-  options.Check();
-  if (scene_grid.size() != scene_points.size() ||
-      scene_grid.radius() != static_cast<float>(options.inlier_threshold_m)) {
-    ThrowInputError("RANSAC", "scene_grid", "a grid over the scene points with the inlier threshold as radius");
-  }
+RansacResult Estimate(const std::vector<Eigen::Vector3f>& object_points,
+                      const std::vector<Eigen::Vector3f>& scene_points, const RadiusGrid* scene_grid,
+                      const std::vector<Correspondence>& correspondences, const RansacOptions& options,
+                      const SceneVisibility* visibility) {
   if (visibility != nullptr) visibility->Check();
+  if (options.projective_stride_px > 0 && visibility == nullptr) {
+    ThrowInputError("RANSAC options", "projective_stride_px", "0 without a SceneVisibility (its depth image)");
+  }
   const auto start = std::chrono::steady_clock::now();
   RansacResult result;
   if (static_cast<int>(correspondences.size()) < options.sample_size || object_points.empty() || scene_points.empty()) {
@@ -424,6 +458,35 @@ RansacResult EstimatePoseRansac(const std::vector<Eigen::Vector3f>& object_point
   }
   result.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return result;
+}
+
+}  // namespace
+
+RansacResult EstimatePoseRansac(const std::vector<Eigen::Vector3f>& object_points,
+                                const std::vector<Eigen::Vector3f>& scene_points,
+                                const std::vector<Correspondence>& correspondences, const RansacOptions& options,
+                                const SceneVisibility* visibility) {
+  options.Check();
+  if (options.projective_stride_px > 0) {
+    return Estimate(object_points, scene_points, nullptr, correspondences, options, visibility);
+  }
+  const RadiusGrid scene_grid(scene_points, static_cast<float>(options.inlier_threshold_m));
+  return Estimate(object_points, scene_points, &scene_grid, correspondences, options, visibility);
+}
+
+RansacResult EstimatePoseRansac(const std::vector<Eigen::Vector3f>& object_points,
+                                const std::vector<Eigen::Vector3f>& scene_points, const RadiusGrid& scene_grid,
+                                const std::vector<Correspondence>& correspondences, const RansacOptions& options,
+                                const SceneVisibility* visibility) {
+  options.Check();
+  if (options.projective_stride_px > 0) {
+    ThrowInputError("RANSAC", "scene_grid", "none when projective_stride_px looks for partners in the depth image");
+  }
+  if (scene_grid.size() != scene_points.size() ||
+      scene_grid.radius() != static_cast<float>(options.inlier_threshold_m)) {
+    ThrowInputError("RANSAC", "scene_grid", "a grid over the scene points with the inlier threshold as radius");
+  }
+  return Estimate(object_points, scene_points, &scene_grid, correspondences, options, visibility);
 }
 
 }  // namespace ecv

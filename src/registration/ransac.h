@@ -56,6 +56,13 @@ struct RansacOptions {
   /// share. Both 0: every pose is counted, as in the paper.
   int min_support = 0;
   double min_support_share = 0.0;
+  /// Where an object point's inlier partner is looked for. 0 (the paper): the nearest scene point in 3D. n > 0
+  /// (beyond the paper; needs a SceneVisibility, whose depth image and camera it uses): the nearest of the 3 x 3
+  /// depth samples n pixels apart centred on the pixel the point projects to. Nine look-ups in the image instead
+  /// of a search among the scene points; a partner within inlier_threshold_m is missed only where the surface
+  /// runs so steeply away from the ray that it lies more than n pixels aside. The scene points then serve the
+  /// correspondences alone.
+  int projective_stride_px = 0;
 
   /// Throws InputError on values outside their ranges.
   void Check() const;
@@ -113,7 +120,8 @@ RansacResult EstimatePoseRansac(const std::vector<Eigen::Vector3f>& object_point
 
 /// The same with `scene_points` already in `scene_grid`, a RadiusGrid over exactly those points with radius
 /// `options.inlier_threshold_m`: a recognizer that tries many views against one frame builds it once (about
-/// 0.3 ms per build over a YCB-Video frame's points). Throws InputError when the grid does not fit.
+/// 0.3 ms per build over a YCB-Video frame's points). Throws InputError when the grid does not fit, or when
+/// options.projective_stride_px asks for the depth image instead (use the overload above: it builds no grid then).
 RansacResult EstimatePoseRansac(const std::vector<Eigen::Vector3f>& object_points,
                                 const std::vector<Eigen::Vector3f>& scene_points, const RadiusGrid& scene_grid,
                                 const std::vector<Correspondence>& correspondences, const RansacOptions& options = {},

@@ -311,6 +311,48 @@ TEST(Ransac, APartlyHiddenObjectIsJudgedByItsVisiblePoints) {
                InputError);
 }
 
+TEST(Ransac, InliersLookedForInTheDepthImageFindTheSamePose) {
+  const OccludedProblem problem = MakeOccludedProblem();
+  RansacOptions options;
+  options.max_iterations = 500;
+  options.inlier_threshold_m = 0.005;
+  options.projective_stride_px = 2;
+  const RansacResult found =
+      EstimatePoseRansac(problem.object, problem.scene, problem.correspondences, options, &problem.visibility);
+  ASSERT_TRUE(found.success);
+  EXPECT_LT(TranslationDistance(found.scene_from_object, problem.scene_from_object), 0.002);
+  EXPECT_LT(RotationAngle(found.scene_from_object, problem.scene_from_object), 1.0 * kDegree);
+  EXPECT_NEAR(found.visible_fraction, 0.43, 0.05);
+  EXPECT_GT(found.inlier_fraction, 0.9);
+  EXPECT_LT(found.fit_error_m, 0.002);  // the depth samples lie on the object's plane, 5 mm apart at most
+}
+
+TEST(Ransac, InliersLookedForInTheDepthImageComeFromItAlone) {
+  // The sensor saw the object's surface 2 cm behind where the matched scene points put it: the nearest scene
+  // point in 3D still confirms the pose, the depth samples along the rays do not.
+  OccludedProblem problem = MakeOccludedProblem();
+  cv::Mat& depth = problem.visibility.depth;
+  depth.setTo(1.02F, depth == 1.0F);
+  RansacOptions options;
+  options.max_iterations = 500;
+  options.inlier_threshold_m = 0.005;
+  EXPECT_TRUE(
+      EstimatePoseRansac(problem.object, problem.scene, problem.correspondences, options, &problem.visibility).success);
+  options.projective_stride_px = 2;
+  EXPECT_FALSE(
+      EstimatePoseRansac(problem.object, problem.scene, problem.correspondences, options, &problem.visibility).success);
+
+  EXPECT_THROW(EstimatePoseRansac(problem.object, problem.scene, problem.correspondences, options), InputError)
+      << "no depth image to look in";
+  const RadiusGrid grid(problem.scene, static_cast<float>(options.inlier_threshold_m));
+  EXPECT_THROW(
+      EstimatePoseRansac(problem.object, problem.scene, grid, problem.correspondences, options, &problem.visibility),
+      InputError)
+      << "a grid that would not be used";
+  options.projective_stride_px = -1;
+  EXPECT_THROW(options.Check(), InputError);
+}
+
 TEST(Ransac, DegenerateInputsFailWithoutACrash) {
   const Problem problem = MakeProblem(50, 50, 50, 0.0, 5);
   EXPECT_FALSE(EstimatePoseRansac({}, {}, {}).success);
