@@ -245,6 +245,7 @@ class Recognizer::Impl {
     // Colour mapping, mesh files and texture decoding on every thread, a batch of models at a time (only a
     // batch's meshes are held at once); the GL uploads on this thread, whose GL context it is.
     const size_t batch = static_cast<size_t>(options_.ransac.threads);
+    std::vector<char> closed(models.size(), 0);  // per model: TriangleMesh::IsClosedOutward
     for (size_t first = 0; first < models.size(); first += batch) {
       std::vector<TriangleMesh> meshes(std::min(batch, models.size() - first));
       ParallelFor(meshes.size(), options_.ransac.threads, [&](size_t i) {
@@ -254,11 +255,14 @@ class Recognizer::Impl {
         load.object_from_mesh = records_[first + i].object_from_mesh;
         load.allow_missing_textures = true;
         meshes[i] = LoadMesh(records_[first + i].mesh_path, load);
+        closed[first + i] = meshes[i].IsClosedOutward() ? 1 : 0;
       });
       for (const TriangleMesh& mesh : meshes) meshes_.push_back(renderer_.AddMesh(mesh));
     }
-    for (const LibraryModel& model : models) {
-      render_options_.emplace_back().shading = StoredViewShading(model.record.build_options_json);
+    for (size_t m = 0; m < models.size(); ++m) {
+      RenderOptions& render = render_options_.emplace_back();
+      render.shading = StoredViewShading(models[m].record.build_options_json);
+      render.cull_back_faces = options_.cull_back_faces && closed[m] != 0;
     }
   }
 

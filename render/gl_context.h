@@ -24,7 +24,7 @@ namespace ecv::gl {
   X(DisableVertexAttribArray) X(VertexAttrib2f) X(VertexAttrib3f) X(DrawBuffers) X(GenVertexArrays) \
   X(DeleteVertexArrays) X(BindVertexArray) X(GenFramebuffers) X(DeleteFramebuffers) X(BindFramebuffer) \
   X(FramebufferRenderbuffer) X(CheckFramebufferStatus) X(GenRenderbuffers) X(DeleteRenderbuffers) \
-  X(BindRenderbuffer) X(RenderbufferStorage) X(GenerateMipmap) X(ClearBufferfv)
+  X(BindRenderbuffer) X(RenderbufferStorage) X(GenerateMipmap) X(ClearBufferfv) X(CullFace) X(FrontFace)
 // clang-format on
 
 /// Pointers to the GL functions above, named without the "gl" prefix: `gl.DrawElements(...)`.

@@ -213,6 +213,13 @@ RenderResult Renderer::Impl::RenderScene(const std::vector<SceneObject>& objects
   gl.Viewport(0, 0, camera.width, camera.height);
   gl.Enable(GL_DEPTH_TEST);
   gl.DepthFunc(GL_LESS);
+  if (options.cull_back_faces) {
+    gl.Enable(GL_CULL_FACE);
+    gl.FrontFace(GL_CW);  // counter-clockwise seen from outside, but the projection mirrors y (image rows down)
+    gl.CullFace(GL_BACK);
+  } else {
+    gl.Disable(GL_CULL_FACE);
+  }
   Clear(options);
   SetFrameUniforms(camera, options);
   for (size_t i = 0; i < objects.size(); ++i) {

@@ -44,6 +44,10 @@ struct RenderOptions {
   bool use_uniform_color = false;     ///< paint every surface in `uniform_color` instead of its own colour
   Eigen::Vector3f uniform_color{1.0F, 0.0F, 0.0F};  ///< RGB in [0, 1], used when use_uniform_color
   Eigen::Vector3f background{0.0F, 0.0F, 0.0F};     ///< RGB in [0, 1] of pixels where no object is seen
+  /// Skip the faces turned away from the camera (counter-clockwise seen from outside is the front). For meshes
+  /// with TriangleMesh::IsClosedOutward() the image is the same (up to a silhouette pixel where a front and a back
+  /// face meet) and the render takes about a third less time; other meshes would show holes.
+  bool cull_back_faces = false;
 
   /// Throws InputError unless 0 < near_m < far_m (finite), 0 <= ambient <= 1 and colours lie in [0, 1].
   void Check() const;

@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numeric>
+#include <tuple>
+#include <utility>
 
 namespace ecv {
 
@@ -73,6 +76,38 @@ double TriangleMesh::Diameter() const {
     }
   }
   return std::sqrt(best_squared);
+}
+
+bool TriangleMesh::IsClosedOutward() const {
+  // Vertices by position: a seam's copies of a vertex become one.
+  std::map<std::tuple<float, float, float>, int> id_of;
+  std::map<std::pair<int, int>, int> directed;  // (from, to) -> how many triangles run through it so
+  double volume6 = 0.0;                         // 6 x the signed volume enclosed
+  for (const MeshPart& part : parts) {
+    std::vector<int> ids(part.positions.size());
+    for (size_t i = 0; i < part.positions.size(); ++i) {
+      const Eigen::Vector3f& p = part.positions[i];
+      ids[i] = id_of.emplace(std::make_tuple(p.x(), p.y(), p.z()), static_cast<int>(id_of.size())).first->second;
+    }
+    for (const Eigen::Vector3i& triangle : part.triangles) {
+      const int a = ids[static_cast<size_t>(triangle.x())], b = ids[static_cast<size_t>(triangle.y())];
+      const int c = ids[static_cast<size_t>(triangle.z())];
+      if (a == b || b == c || a == c) continue;  // a triangle with two corners at one position covers nothing
+      ++directed[{a, b}];
+      ++directed[{b, c}];
+      ++directed[{c, a}];
+      const Eigen::Vector3d p = part.positions[static_cast<size_t>(triangle.x())].cast<double>();
+      const Eigen::Vector3d q = part.positions[static_cast<size_t>(triangle.y())].cast<double>();
+      const Eigen::Vector3d r = part.positions[static_cast<size_t>(triangle.z())].cast<double>();
+      volume6 += p.dot(q.cross(r));
+    }
+  }
+  if (directed.empty()) return false;
+  for (const auto& [edge, count] : directed) {
+    const auto reverse = directed.find({edge.second, edge.first});
+    if (reverse == directed.end() || reverse->second != count) return false;
+  }
+  return volume6 > 0.0;
 }
 
 void TriangleMesh::Transform(const Eigen::Isometry3d& new_from_old) {

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -27,6 +28,39 @@ TEST(TriangleMesh, CountsBoxAndDiameterOfACube) {
   EXPECT_EQ(cube.NumTriangles(), 12U);
   EXPECT_LT((cube.BoundingBox().sizes() - Eigen::Vector3d::Constant(0.1)).norm(), 1e-7);
   EXPECT_NEAR(cube.Diameter(), 0.1 * std::sqrt(3.0), 1e-7);
+}
+
+TEST(TriangleMesh, ClosedOutwardNeedsEveryEdgeRunBothWaysAndFacesTurnedOut) {
+  TriangleMesh inward = Cube(0.1);  // Cube's triangles run clockwise seen from outside
+  EXPECT_FALSE(inward.IsClosedOutward()) << "closed, but turned inwards";
+  TriangleMesh outward = inward;
+  for (Eigen::Vector3i& triangle : outward.parts[0].triangles) std::swap(triangle.y(), triangle.z());
+  EXPECT_TRUE(outward.IsClosedOutward());
+
+  // A texture seam: the +x face in a part of its own with copies of its corners stays closed.
+  TriangleMesh seamed = outward;
+  MeshPart face;
+  for (int corner : {1, 3, 5, 7}) face.positions.push_back(outward.parts[0].positions[static_cast<size_t>(corner)]);
+  std::vector<Eigen::Vector3i>& triangles = seamed.parts[0].triangles;
+  // Odd corners have x = 1.
+  const auto on_face = [](const Eigen::Vector3i& t) { return t.x() % 2 == 1 && t.y() % 2 == 1 && t.z() % 2 == 1; };
+  for (const Eigen::Vector3i& t : triangles) {
+    if (on_face(t)) face.triangles.emplace_back(t.x() / 2, t.y() / 2, t.z() / 2);  // 1, 3, 5, 7 -> 0, 1, 2, 3
+  }
+  triangles.erase(std::remove_if(triangles.begin(), triangles.end(), on_face), triangles.end());
+  ASSERT_EQ(face.triangles.size(), 2U);
+  seamed.parts.push_back(face);
+  EXPECT_TRUE(seamed.IsClosedOutward());
+  seamed.parts[0].triangles.emplace_back(0, 0, 1);  // covers nothing
+  EXPECT_TRUE(seamed.IsClosedOutward());
+
+  TriangleMesh open = outward;
+  open.parts[0].triangles.pop_back();
+  EXPECT_FALSE(open.IsClosedOutward()) << "a missing triangle leaves a hole";
+  TriangleMesh mixed = outward;
+  std::swap(mixed.parts[0].triangles[0].y(), mixed.parts[0].triangles[0].z());
+  EXPECT_FALSE(mixed.IsClosedOutward()) << "one triangle turned over";
+  EXPECT_FALSE(TriangleMesh().IsClosedOutward());
 }
 
 TEST(TriangleMesh, DiameterEqualsBruteForceOnRandomPoints) {

@@ -248,6 +248,37 @@ TEST(RenderTest, MeshWithoutTrianglesIsAnInputError) {
   EXPECT_THROW(renderer.AddMesh(mesh), InputError);
 }
 
+TEST(RenderTest, CullingBackFacesOfAClosedMeshKeepsTheImage) {
+  const YcbFrame ycb = LoadFrame0001();
+  const TriangleMesh mesh = LoadCrackerBox();
+  ASSERT_TRUE(mesh.IsClosedOutward());
+  Renderer renderer;
+  const MeshId box = renderer.AddMesh(mesh);
+  const PinholeCamera& camera = ycb.frame.rgbd.camera;
+  RenderOptions culled;
+  culled.cull_back_faces = true;
+  const RenderResult all = renderer.Render(box, camera, ycb.camera_from_object);
+  const RenderResult front = renderer.Render(box, camera, ycb.camera_from_object, culled);
+  const int pixels = cv::countNonZero(all.mask);
+  ASSERT_GT(pixels, 5000);
+  // Only where a front and a back face meet on the silhouette may a pixel change.
+  EXPECT_LE(cv::countNonZero(all.mask != front.mask), pixels / 1000);
+  const cv::Mat both = all.mask & front.mask;
+  EXPECT_LT(cv::norm(all.depth, front.depth, cv::NORM_INF, both), 1e-6) << "the same surface, not the far side";
+  EXPECT_EQ(cv::norm(all.color, front.color, cv::NORM_INF, both), 0.0);
+
+  // Turned inside out, the culled box shows its far side: the faces nearest the camera now turn away from it.
+  TriangleMesh inside_out = mesh;
+  for (MeshPart& part : inside_out.parts) {
+    for (Eigen::Vector3i& triangle : part.triangles) std::swap(triangle.y(), triangle.z());
+  }
+  const RenderResult far = renderer.Render(renderer.AddMesh(inside_out), camera, ycb.camera_from_object, culled);
+  const cv::Mat seen = all.mask & far.mask;
+  ASSERT_GT(cv::countNonZero(seen), pixels * 9 / 10);
+  cv::Mat deeper = far.depth > all.depth + 0.01F;
+  EXPECT_GT(cv::countNonZero(deeper & seen), cv::countNonZero(seen) * 9 / 10);
+}
+
 TEST(RenderTest, RenderingTwiceGivesIdenticalImages) {
   const YcbFrame ycb = LoadFrame0001();
   Renderer renderer;
