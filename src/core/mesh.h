@@ -54,8 +54,8 @@ struct TriangleMesh {
   /// True when the triangles, over all parts, close into surfaces whose faces all turn their counter-clockwise
   /// side outwards: every edge (vertices compared by position, so texture seams do not open it) is run through
   /// as often in one direction as in the other (once each but where surfaces pinch), and the enclosed volume is
-  /// positive. Triangles with two corners at one position are left out: they cover nothing. Only then may a renderer skip the faces
-  /// turned away from the camera (RenderOptions::cull_back_faces) without changing the image.
+  /// positive (triangles with two corners at one position cover nothing and are left out). Only then may a renderer
+  /// skip the faces turned away from the camera (RenderOptions::cull_back_faces) without changing the image.
   bool IsClosedOutward() const;
 
   /// Maps every position and normal by `new_from_old` (x_new = R x_old + t).
