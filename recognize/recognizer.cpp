@@ -591,13 +591,13 @@ class Recognizer::Impl {
     hypothesis.view = candidate->view;
     const std::vector<Eigen::Vector3f> object_points =
         PrimitivePositions(record.views[static_cast<size_t>(candidate->view)].primitives);
-    if (scene.ransac_grid) {
-      hypothesis.ransac = EstimatePoseRansac(object_points, scene.ransac_points, *scene.ransac_grid,
-                                             candidate->correspondences, ransac, &scene.visibility);
-    } else {
+    if (options_.projective_inliers) {
       ransac.projective_stride_px = options_.ransac_stride_px;
       hypothesis.ransac =
           EstimatePoseRansac(object_points, scene.ransac_points, candidate->correspondences, ransac, &scene.visibility);
+    } else {
+      hypothesis.ransac = EstimatePoseRansac(object_points, scene.ransac_points, *scene.ransac_grid,
+                                             candidate->correspondences, ransac, &scene.visibility);
     }
     hypothesis.pose = hypothesis.ransac.scene_from_object;
     (*timings_ms)["ransac"] += MillisecondsSince(stage);

@@ -289,21 +289,32 @@ OccludedProblem MakeOccludedProblem() {
   return problem;
 }
 
-TEST(Ransac, APartlyHiddenObjectIsJudgedByItsVisiblePoints) {
-  const OccludedProblem problem = MakeOccludedProblem();
-  ASSERT_GT(problem.correspondences.size(), 100U);
+// The settings the occluded problem is solved with: few samples, an inlier within 5 mm.
+RansacOptions OccludedOptions() {
   RansacOptions options;
   options.max_iterations = 500;
   options.inlier_threshold_m = 0.005;
+  return options;
+}
+
+// `found` is the occluded problem's pose, judged by the 43 % of the object that is visible.
+void ExpectVisiblePartFound(const RansacResult& found, const OccludedProblem& problem) {
+  ASSERT_TRUE(found.success);
+  EXPECT_LT(TranslationDistance(found.scene_from_object, problem.scene_from_object), 0.002);
+  EXPECT_LT(RotationAngle(found.scene_from_object, problem.scene_from_object), 1.0 * kDegree);
+  EXPECT_NEAR(found.visible_fraction, 0.43, 0.05);
+  EXPECT_GT(found.inlier_fraction, 0.9);
+}
+
+TEST(Ransac, APartlyHiddenObjectIsJudgedByItsVisiblePoints) {
+  const OccludedProblem problem = MakeOccludedProblem();
+  ASSERT_GT(problem.correspondences.size(), 100U);
+  const RansacOptions options = OccludedOptions();
   const RansacResult blind = EstimatePoseRansac(problem.object, problem.scene, problem.correspondences, options);
   EXPECT_FALSE(blind.success) << "only about 40 % of the object points can be inliers";
-  const RansacResult seeing =
-      EstimatePoseRansac(problem.object, problem.scene, problem.correspondences, options, &problem.visibility);
-  ASSERT_TRUE(seeing.success);
-  EXPECT_LT(TranslationDistance(seeing.scene_from_object, problem.scene_from_object), 0.002);
-  EXPECT_LT(RotationAngle(seeing.scene_from_object, problem.scene_from_object), 1.0 * kDegree);
-  EXPECT_NEAR(seeing.visible_fraction, 0.43, 0.05);
-  EXPECT_GT(seeing.inlier_fraction, 0.9);
+  ExpectVisiblePartFound(
+      EstimatePoseRansac(problem.object, problem.scene, problem.correspondences, options, &problem.visibility),
+      problem);
 
   SceneVisibility wrong_size = problem.visibility;
   wrong_size.depth = cv::Mat(10, 10, CV_32FC1, cv::Scalar(1.0F));
@@ -313,17 +324,11 @@ TEST(Ransac, APartlyHiddenObjectIsJudgedByItsVisiblePoints) {
 
 TEST(Ransac, InliersLookedForInTheDepthImageFindTheSamePose) {
   const OccludedProblem problem = MakeOccludedProblem();
-  RansacOptions options;
-  options.max_iterations = 500;
-  options.inlier_threshold_m = 0.005;
+  RansacOptions options = OccludedOptions();
   options.projective_stride_px = 2;
   const RansacResult found =
       EstimatePoseRansac(problem.object, problem.scene, problem.correspondences, options, &problem.visibility);
-  ASSERT_TRUE(found.success);
-  EXPECT_LT(TranslationDistance(found.scene_from_object, problem.scene_from_object), 0.002);
-  EXPECT_LT(RotationAngle(found.scene_from_object, problem.scene_from_object), 1.0 * kDegree);
-  EXPECT_NEAR(found.visible_fraction, 0.43, 0.05);
-  EXPECT_GT(found.inlier_fraction, 0.9);
+  ExpectVisiblePartFound(found, problem);
   EXPECT_LT(found.fit_error_m, 0.002);  // the depth samples lie on the object's plane, 5 mm apart at most
 }
 
@@ -333,9 +338,7 @@ TEST(Ransac, InliersLookedForInTheDepthImageComeFromItAlone) {
   OccludedProblem problem = MakeOccludedProblem();
   cv::Mat& depth = problem.visibility.depth;
   depth.setTo(1.02F, depth == 1.0F);
-  RansacOptions options;
-  options.max_iterations = 500;
-  options.inlier_threshold_m = 0.005;
+  RansacOptions options = OccludedOptions();
   EXPECT_TRUE(
       EstimatePoseRansac(problem.object, problem.scene, problem.correspondences, options, &problem.visibility).success);
   options.projective_stride_px = 2;
