@@ -228,6 +228,12 @@ CommandAction SetupRecognizeCommand(CLI::App& command) {
       .add_option("--good-enough-score", options.good_enough_score,
                   "A model's remaining views are skipped once one verifies at this score (0: try them all)")
       ->capture_default_str();
+  command
+      .add_option("--give-up-after", options.give_up_after_views,
+                  "A model's remaining views are skipped when its first N all verify below --give-up-score:\n"
+                  "it is taken to be absent (0: try --views-per-model views)")
+      ->capture_default_str();
+  command.add_option("--give-up-score", options.give_up_below_score, "See --give-up-after")->capture_default_str();
   command.add_option("--min-score", options.min_score, "Detections below this score are dropped")
       ->capture_default_str();
   command

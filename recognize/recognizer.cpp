@@ -205,6 +205,8 @@ void RecognizerOptions::Check() const {
   };
   require(views_per_model >= 1, "views_per_model", "at least 1");
   require(good_enough_score >= 0.0, "good_enough_score", ">= 0 (0: try every ranked view)");
+  require(give_up_after_views >= 0, "give_up_after_views", ">= 0 (0: never give up)");
+  require(give_up_below_score >= 0.0, "give_up_below_score", ">= 0");
   consistency.Check();
   plane_patch.Check();
   require(consistency_max_correspondences >= 3, "consistency_max_correspondences", "at least 3");
@@ -343,6 +345,7 @@ class Recognizer::Impl {
     const auto searched = static_cast<int>(std::count(done.begin(), done.end(), false));
     ransac_threads_ = std::max(1, options_.ransac.threads / std::max(1, searched));
     std::vector<std::map<std::string, double>> model_timings(models);
+    std::vector<int> views_tried(models, -1);  // -1: not searched
     ParallelFor(models, options_.ransac.threads, [&](size_t m) {
       if (done[m]) return;
       const Clock::time_point ranking = Clock::now();
@@ -353,14 +356,19 @@ class Recognizer::Impl {
         // Once an instance is found the model is known to be in the frame: more of its views are worth trying.
         const int views = instances(m) == 0 || options_.later_instance_views == 0 ? options_.views_per_model
                                                                                   : options_.later_instance_views;
-        std::optional<Verified> best = BestDetection(m, views, scene, covered[m], &ranked, &model_timings[m]);
+        const int give_up_after = instances(m) == 0 ? options_.give_up_after_views : 0;
+        std::optional<Verified> best =
+            BestDetection(m, views, give_up_after, scene, covered[m], &ranked, &model_timings[m]);
         if (!best || !Accepted(best->detection)) break;
         add_instance(m, std::move(*best));
       }
+      views_tried[m] = static_cast<int>(
+          std::count_if(ranked.begin(), ranked.end(), [](const ViewCandidate& view) { return view.tried; }));
     });
     std::vector<Verified> candidates;
     for (size_t m = 0; m < models; ++m) {
       for (auto& [name, ms] : model_timings[m]) result.timings_ms[name] += ms;
+      if (views_tried[m] >= 0) result.views_tried[records_[m].name] = views_tried[m];
       for (Verified& verified : found[m]) candidates.push_back(std::move(verified));
     }
     stage = Clock::now();
@@ -452,14 +460,20 @@ class Recognizer::Impl {
     result->timings_ms["describe"] = MillisecondsSince(stage);
   }
 
-  // The model's best pose over its best `count` ranked views: RANSAC per view, each pose verified as it is
+  // The model's best pose over its best `count` ranked views (fewer once one is good enough, or when the first
+  // `give_up_after` show none at give_up_below_score; 0: never give up): RANSAC per view, each pose verified as it is
   // (both once per view and frame, kept in `ranked`), the best one not lying mostly (max_overlap) on `covered`
   // pixels (earlier instances) refined by ICP and verified again (kept only if ICP does not lower its score), and so
   // is its rival turned away from it (TurnedRival), the better of the two kept. Adds stage times.
-  std::optional<Verified> BestDetection(size_t model, int count, const Scene& scene, const cv::Mat& covered,
-                                        std::vector<ViewCandidate>* ranked, std::map<std::string, double>* timings_ms) {
+  std::optional<Verified> BestDetection(size_t model, int count, int give_up_after, const Scene& scene,
+                                        const cv::Mat& covered, std::vector<ViewCandidate>* ranked,
+                                        std::map<std::string, double>* timings_ms) {
     const ViewCandidate* best_view = nullptr;
     for (size_t i = 0; i < std::min(ranked->size(), static_cast<size_t>(count)); ++i) {
+      if (give_up_after > 0 && i == static_cast<size_t>(give_up_after) &&
+          (best_view == nullptr || best_view->verified->detection.score < options_.give_up_below_score)) {
+        break;
+      }
       ViewCandidate& candidate = (*ranked)[i];
       Try(model, scene, &candidate, timings_ms);
       if (!candidate.verified || CoveredShare(candidate.verified->surface, covered) > options_.max_overlap) continue;
@@ -898,7 +912,10 @@ nlohmann::json RecognitionToJson(const RecognitionResult& result) {
                           {"edge_pixels", d.edge_pixels},
                           {"tracked", d.tracked}});
   }
-  return {{"detections", detections}, {"timings_ms", result.timings_ms}, {"scene_primitives", result.scene_primitives}};
+  return {{"detections", detections},
+          {"timings_ms", result.timings_ms},
+          {"scene_primitives", result.scene_primitives},
+          {"views_tried", result.views_tried}};
 }
 
 std::vector<Detection> DetectionsFromJson(const nlohmann::json& json, const std::string& source) {

@@ -370,6 +370,12 @@ TEST(RecognizerOptions, OutOfRangeValuesAreReportedByName) {
   options.good_enough_score = -0.1;
   EXPECT_NE(message(options).find("good_enough_score"), std::string::npos) << message(options);
   options = RecognizerOptions();
+  options.give_up_after_views = -1;
+  EXPECT_NE(message(options).find("give_up_after_views"), std::string::npos) << message(options);
+  options = RecognizerOptions();
+  options.give_up_below_score = -0.1;
+  EXPECT_NE(message(options).find("give_up_below_score"), std::string::npos) << message(options);
+  options = RecognizerOptions();
   options.edge_weight = 1.2;
   EXPECT_NE(message(options).find("edge_weight"), std::string::npos) << message(options);
   options = RecognizerOptions();

@@ -3,6 +3,7 @@
 // `ecvpose modeldb build`, then `ecvpose recognize --sequence` over frame 000001 of videos 0000, 0001 and
 // 0002 (7 textured objects in all), scored against the ground truth.
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -201,6 +202,44 @@ TEST_F(YcbvLibrary, SameSeedSameOutputWithOneOrTwoThreads) {
   const std::vector<nlohmann::json> two = Recognize("two", "--threads 2 --seed 7", frames);
   ASSERT_EQ(one.size(), two.size());
   for (size_t i = 0; i < one.size(); ++i) EXPECT_EQ(one[i].at("detections"), two[i].at("detections")) << i;
+}
+
+// RecognizerOptions::give_up_after_views on 0001/000001 (the cracker box, sugar box and mustard bottle; the other
+// 4 models absent): every model tries its 7 views when it never gives up, and 3 when no score can stay on; by
+// default some absent model is given up after 4 views, and the detections are the same as without giving up.
+TEST_F(YcbvLibrary, AModelWhoseFirstViewsAllScoreLowIsGivenUpWithTheSameDetections) {
+  LibraryLoadOptions load;
+  load.build_matchers = false;
+  const ModelLibrary library = ModelLibrary::Load(library_, load);
+  const LoadedFrame frame = LoadYcbvFrame(Frames()[1]);
+  auto recognize = [&](int give_up_after, double give_up_below, double good_enough) {
+    RecognizerOptions options;
+    options.give_up_after_views = give_up_after;
+    options.give_up_below_score = give_up_below;
+    options.good_enough_score = good_enough;
+    return Recognizer(library, options).Recognize(frame.rgbd);
+  };
+  const RecognitionResult every_view = recognize(0, 0.1, 0.0);
+  const RecognitionResult three_views = recognize(3, 2.0, 0.0);  // scores lie in [0, 1]: none stays on
+  ASSERT_EQ(every_view.views_tried.size(), 7U);
+  ASSERT_EQ(three_views.views_tried.size(), 7U);
+  for (const auto& [model, tried] : every_view.views_tried) {
+    EXPECT_EQ(tried, RecognizerOptions().views_per_model) << model;
+    EXPECT_EQ(three_views.views_tried.at(model), 3) << model;
+  }
+
+  const RecognitionResult given_up = recognize(4, 0.1, RecognizerOptions().good_enough_score);
+  const RecognitionResult never = recognize(0, 0.1, RecognizerOptions().good_enough_score);
+  EXPECT_EQ(RecognitionToJson(given_up).at("detections"), RecognitionToJson(never).at("detections"));
+  EXPECT_EQ(given_up.detections.size(), 3U);
+  int absent_given_up = 0;
+  for (const auto& [model, tried] : given_up.views_tried) {
+    const bool present = std::any_of(frame.ground_truth.begin(), frame.ground_truth.end(),
+                                     [&](const GroundTruth& truth) { return truth.object_name == model; });
+    if (!present && tried == 4) ++absent_given_up;
+    EXPECT_LE(tried, never.views_tried.at(model)) << model;
+  }
+  EXPECT_GE(absent_given_up, 1);
 }
 
 TEST_F(YcbvLibrary, TracksTheThreeObjectsOfVideo0001FromFrameToFrame) {
