@@ -33,8 +33,10 @@ struct RecognizerOptions {
   /// search from 100 descriptors; before those, 5 views found 49/43/44); 3 views at ~37 000 samples found 45/39/39,
   /// and with seed 1, 8 views at 5000 samples 43. The right view is often not ranked first: of the 70 objects, 68
   /// have a library view with 6 or more right correspondences among its 200 ranking ones, and such a view is
-  /// among the best-ranked 5 for 56 of them (session 7, scratch study).
-  int views_per_model = 7;
+  /// among the best-ranked 5 for 56 of them (session 7, scratch study). With give_up_after_views, 10 views found
+  /// 62 / 59 / 61 with 0 / 2 / 0 false positives against 7 views' 61 / 59 / 59 with 1 / 2 / 1 (session 27), from
+  /// 1058 instead of 914 views tried over the 30 frames (seed 1; 7 views without giving up: 1295).
+  int views_per_model = 10;
   /// A model's remaining ranked views are not tried once one verifies at or above this score (0: always try
   /// views_per_model). On the 30 YCB-Video frames (seeds 1/2/3) 0.5 found the same 49/47/46 of 70 objects with
   /// the same false positives, in 1433/1403/1413 instead of 1620/1563/1569 ms per frame (median, one thread).

@@ -205,7 +205,7 @@ TEST_F(YcbvLibrary, SameSeedSameOutputWithOneOrTwoThreads) {
 }
 
 // RecognizerOptions::give_up_after_views on 0001/000001 (the cracker box, sugar box and mustard bottle; the other
-// 4 models absent): every model tries its 7 views when it never gives up, and 3 when no score can stay on; by
+// 4 models absent): every model tries views_per_model views when it never gives up, and 3 when no score can stay on; by
 // default some absent model is given up after 4 views, and the detections are the same as without giving up.
 TEST_F(YcbvLibrary, AModelWhoseFirstViewsAllScoreLowIsGivenUpWithTheSameDetections) {
   LibraryLoadOptions load;
