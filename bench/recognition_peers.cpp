@@ -9,7 +9,7 @@
 #include <unordered_map>
 
 #include "core/error.h"
-#include "io/mesh_io.h"
+#include "modeldb/model_record.h"
 
 namespace ecv::bench {
 namespace {
@@ -76,12 +76,8 @@ void PeerOptions::Check() const {
 
 PeerModel SamplePeerModel(const ModelRecord& record, double spacing_m, unsigned seed) {
   if (!(spacing_m > 0.0)) ThrowInputError("SamplePeerModel", "spacing_m", "a spacing > 0 m", std::to_string(spacing_m));
-  MeshLoadOptions load;
-  load.metres_per_unit = MetresPerUnit(record.unit);
-  load.object_from_mesh = record.object_from_mesh;
-  load.allow_missing_textures = true;
-  const std::vector<Triangle> triangles = Triangles(LoadMesh(record.mesh_path, load));
-  if (triangles.empty()) ThrowInputError(record.mesh_path, "triangles", "a mesh with triangles of non-zero area");
+  const std::vector<Triangle> triangles = Triangles(ModelMesh(record, /*with_textures=*/false));
+  if (triangles.empty()) ThrowInputError(record.name, "triangles", "a mesh with triangles of non-zero area");
   std::vector<double> cumulative_area;
   double area = 0.0;
   for (const Triangle& t : triangles) {

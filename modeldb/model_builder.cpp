@@ -69,6 +69,7 @@ void ModelBuildOptions::Check() const {
   render.Check();
   features.ecv.Check();
   features.descriptor.Check();
+  mesh_blob.Check();
   if (threads < 1) ThrowInputError("model build options", "threads", "at least 1", std::to_string(threads));
 }
 
@@ -133,6 +134,7 @@ BuildResult BuildModel(const ModelSource& source, const ModelBuildOptions& optio
   const TriangleMesh mesh = LoadMesh(source.mesh_path, load, &result.warnings);
   ModelRecord& record = result.record;
   record.mesh_sha256 = Sha256OfFiles(MeshContentFiles(source.mesh_path, mesh));
+  if (options.store_mesh) record.mesh_blob = EncodeMeshBlob(mesh, options.mesh_blob);
   result.timings.load_ms = MillisecondsSince(start);
   record.name = source.name.empty() ? std::filesystem::path(source.mesh_path).stem().string() : source.name;
   record.mesh_path = std::filesystem::absolute(source.mesh_path).lexically_normal().string();

@@ -8,6 +8,7 @@
 
 #include "core/camera.h"
 #include "core/mesh.h"
+#include "io/mesh_blob.h"
 #include "modeldb/model_record.h"
 #include "render/renderer.h"
 #include "render/view_sampling.h"
@@ -38,6 +39,11 @@ struct ModelBuildOptions {
   /// The recognizer renders each model in verification as its views were (StoredViewShading).
   bool shade_untextured = true;
   FeatureSettings features;  ///< extraction and descriptor settings
+  /// Store the mesh in the record (ModelRecord::mesh_blob), so that recognition verifies poses without the mesh
+  /// file and without decoding its full-size textures: with the 7 YCB models (4096 px PNG textures), see
+  /// bench/RESULTS.md (session 28). Textures are kept up to mesh_blob.max_texture_size (the recognizer's own cap).
+  bool store_mesh = true;
+  MeshBlobOptions mesh_blob;
   int threads = 1;  ///< worker threads describing each view (ComputeDescriptors); the model does not depend on it
 
   /// Throws InputError naming the field for nonsense values (via the parts' Check()).
@@ -69,7 +75,7 @@ using BuildProgressCallback = std::function<void(const BuildProgress&)>;
 
 /// Time per step of a build, milliseconds (summed over the views).
 struct BuildTimings {
-  double load_ms = 0.0;      ///< reading the mesh and its textures, hashing them
+  double load_ms = 0.0;      ///< reading the mesh and its textures, hashing them, packing it (store_mesh)
   double upload_ms = 0.0;    ///< uploading the mesh to the renderer
   double render_ms = 0.0;    ///< rendering the views
   double extract_ms = 0.0;   ///< ECV primitives and the move into the object frame

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "modeldb/content_hash.h"
 #include "modeldb/model_database_impl.h"
 #include "modeldb/schema.h"
 
@@ -88,6 +89,12 @@ void InsertView(SqlConnection& connection, int64_t model_id, const ModelView& vi
   insert.Bind(7, c.width).Bind(8, c.height).Bind(9, PoseText(view.camera_from_object));
   insert.Run();
   InsertPrimitives(connection, connection.LastInsertRowId(), view);
+}
+
+void InsertMeshBlob(SqlConnection& connection, int64_t model_id, const std::vector<unsigned char>& blob) {
+  SqlStatement insert = connection.Prepare("INSERT INTO meshes (model_id, sha256, data) VALUES (?, ?, ?)");
+  insert.Bind(1, model_id).Bind(2, Sha256Hex(blob.data(), blob.size())).BindBlob(3, blob.data(), blob.size());
+  insert.Run();
 }
 
 void WriteColorMatrix(SqlConnection& connection, int64_t model_id, const ColorMatrixRecord& matrix,
@@ -190,6 +197,7 @@ AddModelResult ModelDatabase::AddModel(const ModelRecord& record, const InsertPr
     InsertView(connection, model_id, record.views[v]);
     if (progress) progress(static_cast<int>(v + 1), static_cast<int>(record.views.size()));
   }
+  if (!record.mesh_blob.empty()) InsertMeshBlob(connection, model_id, record.mesh_blob);
   if (kept_matrix) WriteColorMatrix(connection, model_id, *kept_matrix, kept_matrix->created);
   transaction.Commit();
   result.insert_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

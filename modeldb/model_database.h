@@ -46,7 +46,7 @@ struct VerifyReport {
   bool ok() const { return problems.empty(); }
 };
 
-/// The object library in one SQLite file (schema in modeldb/README.md): models, their views, primitives in
+/// The object library in one SQLite file (schema in modeldb/README.md): models, their meshes, views, primitives in
 /// the object frame, descriptors, colour matrices, and the feature settings every model was built with.
 /// Every change is one transaction: a model is in the library whole or not at all. Write-ahead logging
 /// lets readers load while a writer adds. One object must not be used by two threads at once.
@@ -95,7 +95,7 @@ class ModelDatabase {
   std::vector<StoredModel> LoadModels(const std::vector<std::string>& names = {}) const;
 
   /// SQLite's integrity and foreign-key checks, stored counts against the rows, view and primitive numbering,
-  /// and (when `check_descriptors`) the descriptor digest of every model.
+  /// and (when `check_descriptors`) the digests of every model's descriptors and stored mesh.
   VerifyReport Verify(bool check_descriptors = true) const;
 
  private:

@@ -170,6 +170,7 @@ ModelSummary ReadSummary(const SqlStatement& row, const std::string& path) {
   summary.descriptor_sha256 = row.Text(11);
   summary.created = row.Text(12);
   summary.has_color_matrix = row.Int(13) != 0;
+  summary.mesh_blob_bytes = row.Int(14);
   return summary;
 }
 

@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "core/error.h"
+#include "modeldb/content_hash.h"
 #include "modeldb/model_database.h"
 #include "modeldb/model_database_impl.h"
 #include "modeldb/schema.h"
@@ -89,6 +90,13 @@ ModelRecord ReadModel(SqlConnection& connection, const std::string& name, const 
   record.build_options_json = summary.build_options_json;
   record.features = features;
   record.views = ReadViews(connection, id, connection.path() + ": model " + name);
+  SqlStatement mesh = connection.Prepare("SELECT data FROM meshes WHERE model_id = ?");
+  mesh.Bind(1, id);
+  if (mesh.Step()) {
+    size_t size = 0;
+    const auto* data = static_cast<const unsigned char*>(mesh.Blob(0, &size));
+    record.mesh_blob.assign(data, data + size);
+  }
   return record;
 }
 
@@ -126,6 +134,18 @@ void CheckDescriptorDigests(SqlConnection& connection, std::vector<std::string>*
   while (models.Step()) {
     if (StoredDescriptorSha256(connection, models.Int(0)) != models.Text(2)) {
       problems->push_back("model " + models.Text(1) + ": descriptor values differ from those stored (digest)");
+    }
+  }
+}
+
+void CheckMeshDigests(SqlConnection& connection, std::vector<std::string>* problems) {
+  SqlStatement meshes = connection.Prepare(
+      "SELECT m.name, x.sha256, x.data FROM meshes x JOIN models m ON m.id = x.model_id ORDER BY m.name");
+  while (meshes.Step()) {
+    size_t size = 0;
+    const void* data = meshes.Blob(2, &size);
+    if (Sha256Hex(data, size) != meshes.Text(1)) {
+      problems->push_back("model " + meshes.Text(0) + ": stored mesh differs from the one written (digest)");
     }
   }
 }
@@ -181,7 +201,10 @@ VerifyReport ModelDatabase::Verify(bool check_descriptors) const {
       report.problems.push_back(error.what());
     }
   }
-  if (check_descriptors) CheckDescriptorDigests(connection, &report.problems);
+  if (check_descriptors) {
+    CheckDescriptorDigests(connection, &report.problems);
+    CheckMeshDigests(connection, &report.problems);
+  }
   snapshot.Commit();
   return report;
 }

@@ -3,6 +3,8 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "io/mesh_blob.h"
+#include "io/mesh_io.h"
 #include "modeldb/content_hash.h"
 
 namespace ecv {
@@ -110,6 +112,18 @@ std::string ModelRecord::DescriptorSha256() const {
     for (int row = 0; row < values.rows; ++row) hash.Update(values.ptr<float>(row), kDescriptorSize * sizeof(float));
   }
   return hash.HexDigest();
+}
+
+TriangleMesh ModelMesh(const ModelRecord& record, bool with_textures) {
+  if (!record.mesh_blob.empty()) {
+    return DecodeMeshBlob(record.mesh_blob.data(), record.mesh_blob.size(), "model " + record.name + ": stored mesh",
+                          with_textures);
+  }
+  MeshLoadOptions load;
+  load.metres_per_unit = MetresPerUnit(record.unit);
+  load.object_from_mesh = record.object_from_mesh;
+  load.allow_missing_textures = true;
+  return LoadMesh(record.mesh_path, load);
 }
 
 }  // namespace ecv

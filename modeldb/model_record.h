@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 
 #include "core/camera.h"
+#include "core/mesh.h"
 #include "ecv/descriptor.h"
 #include "ecv/primitives.h"
 
@@ -54,6 +55,10 @@ struct ModelRecord {
   std::string build_options_json;  ///< how the views were made (views, camera, distance, shading), JSON
   FeatureSettings features;        ///< extraction and descriptor settings used
   std::vector<ModelView> views;
+  /// The mesh as rendered (object frame, metres, textures capped), packed by io/mesh_blob.h, so that verification
+  /// needs no mesh file; empty when not stored (a model of a schema-1 library, or built with store_mesh off):
+  /// ModelMesh then reads mesh_path.
+  std::vector<unsigned char> mesh_blob;
 
   int NumPrimitives() const;
   int NumDescriptors() const;
@@ -61,6 +66,12 @@ struct ModelRecord {
   /// the descriptors are equal bit for bit.
   std::string DescriptorSha256() const;
 };
+
+/// The mesh of a library model in the object frame (metres): the stored one (mesh_blob) when there is one, else
+/// its mesh file (mesh_path with the record's unit and object_from_mesh; missing textures tolerated, as in the
+/// build). Without `with_textures`, geometry alone (a stored mesh's textures are not decoded). Throws InputError
+/// naming the model for stored bytes that do not decode, or the file for one that cannot be read.
+TriangleMesh ModelMesh(const ModelRecord& record, bool with_textures = true);
 
 /// A 3x3 colour matrix of a model (paper Sect. IV-C): c_scene = model_to_scene * c_model (RGB in [0, 1]).
 struct ColorMatrixRecord {
@@ -91,7 +102,8 @@ struct ModelSummary {
   int num_descriptors = 0;
   std::string descriptor_sha256;
   bool has_color_matrix = false;
-  std::string created;  ///< UTC time of storing, ISO 8601
+  long long mesh_blob_bytes = 0;  ///< size of the stored mesh; 0 when the model reads its mesh file
+  std::string created;            ///< UTC time of storing, ISO 8601
 };
 
 }  // namespace ecv

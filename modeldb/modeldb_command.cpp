@@ -37,6 +37,8 @@ struct ModeldbArgs {
   bool symmetric = false;
   std::string feature_settings;  // JSON file of FeatureSettings; empty: the defaults
   int threads = app::AllCores();
+  bool no_stored_mesh = false;
+  int mesh_texture_size = MeshBlobOptions().max_texture_size;
   // list, info, remove, export, verify
   std::string model;
   bool json = false;
@@ -76,6 +78,8 @@ ModelBuildOptions BuildArguments(const ModeldbArgs& args) {
   options.camera = CameraArgument(args);
   options.render.shading = args.shading == "headlight" ? Shading::kHeadlight : Shading::kUnlit;
   options.shade_untextured = args.shading == "auto";
+  options.store_mesh = !args.no_stored_mesh;
+  options.mesh_blob.max_texture_size = args.mesh_texture_size;
   if (!args.feature_settings.empty()) {  // --feature-settings: e.g. {"descriptor": {"pairs": 1}}
     std::ifstream file(args.feature_settings);
     std::stringstream text;
@@ -122,6 +126,9 @@ bool BuildOne(const ModelSource& source, const ModelBuildOptions& options, const
               << " primitives, " << built.record.NumDescriptors() << " descriptors (render "
               << Fixed(t.render_ms / 1000, 1) << " s, extract " << Fixed(t.extract_ms / 1000, 1) << " s, describe "
               << Fixed(t.describe_ms / 1000, 1) << " s, insert " << Fixed(added.insert_ms / 1000, 1) << " s)"
+              << (built.record.mesh_blob.empty()
+                      ? std::string(", mesh not stored")
+                      : ", mesh stored (" + Fixed(built.record.mesh_blob.size() / 1e6, 1) + " MB)")
               << (added.replaced ? "; replaced the earlier model" : "")
               << (added.color_matrix_kept ? ", kept its colour matrix" : "")
               << (added.color_matrix_dropped ? ", dropped its colour matrix (the mesh changed)" : "") << '\n';
@@ -179,6 +186,7 @@ nlohmann::ordered_json SummaryJson(const ModelSummary& m) {
           {"descriptors", m.num_descriptors},
           {"descriptor_sha256", m.descriptor_sha256},
           {"color_matrix", m.has_color_matrix},
+          {"stored_mesh_bytes", m.mesh_blob_bytes},
           {"build_options", nlohmann::json::parse(m.build_options_json, nullptr, false)},
           {"created", m.created}};
 }
@@ -194,12 +202,13 @@ int RunList(const ModeldbArgs& args) {
   }
   std::printf("%s: %zu models (schema version %d)\n", args.db.c_str(), models.size(), kModelDbSchemaVersion);
   if (models.empty()) return kExitOk;
-  std::printf("%-28s %6s %11s %12s %12s %9s %7s  %s\n", "name", "views", "primitives", "descriptors", "diameter_mm",
-              "symmetric", "colour", "created");
+  std::printf("%-28s %6s %11s %12s %12s %9s %7s %8s  %s\n", "name", "views", "primitives", "descriptors", "diameter_mm",
+              "symmetric", "colour", "mesh_MB", "created");
   for (const ModelSummary& m : models) {
-    std::printf("%-28s %6d %11d %12d %12.1f %9s %7s  %s\n", m.name.c_str(), m.num_views, m.num_primitives,
+    const std::string mesh = m.mesh_blob_bytes > 0 ? Fixed(m.mesh_blob_bytes / 1e6, 1) : "file";  // not stored
+    std::printf("%-28s %6d %11d %12d %12.1f %9s %7s %8s  %s\n", m.name.c_str(), m.num_views, m.num_primitives,
                 m.num_descriptors, 1000.0 * m.diameter_m, m.symmetric ? "yes" : "no", m.has_color_matrix ? "yes" : "no",
-                m.created.c_str());
+                mesh.c_str(), m.created.c_str());
   }
   return kExitOk;
 }
@@ -321,13 +330,21 @@ void AddBuildFlags(CLI::App& build, ModeldbArgs* args) {
       .add_option("--threads", args->threads,
                   "Worker threads describing each view (the same library for any count; default: all cores)")
       ->check(AtLeastOne());
+  build.add_flag("--no-stored-mesh", args->no_stored_mesh,
+                 "Do not store the meshes in the library: recognition then reads each mesh file (mesh_path)");
+  build
+      .add_option("--mesh-texture-size", args->mesh_texture_size,
+                  "Largest side of a stored mesh's textures, pixels (larger ones are downscaled; 0: as they are)")
+      ->capture_default_str()
+      ->check(NonNegative());
   build.add_option("--feature-settings", args->feature_settings,
                    "JSON of extraction and descriptor settings, {\"ecv\": {...}, \"descriptor\": {...}} as "
                    "`modeldb info` shows them (missing fields: defaults)");
   build.footer(
       "A directory holds one folder per model, <name>/<name>.obj, with object_from_mesh.json beside the mesh when\n"
       "the mesh's frame differs from the object frame; --object-from-mesh FILE overrides those for every mesh.\n"
-      "Each model is stored in one transaction; a model that exists is replaced. Exit code 1 if any failed.");
+      "Each model is stored in one transaction, with its mesh (textures at most --mesh-texture-size), so that\n"
+      "recognition needs no mesh file; a model that exists is replaced. Exit code 1 if any failed.");
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 // The library's tables, the version check and the migration steps. Version 1 is the first released schema;
-// version 0 is the prototype layout (see kPrototypeTables) that step 0 -> 1 brings up to date.
+// version 0 is the prototype layout (see kPrototypeTables) that step 0 -> 1 brings up to date; version 2 adds the
+// models' meshes (the table `meshes`), so that a library verifies its poses without the mesh files.
 
 #include "modeldb/schema.h"
 
@@ -13,7 +14,7 @@ namespace ecv {
 namespace {
 
 // The ecvpose version that introduced each schema version (index = version), for the refusal of a newer file.
-const char* const kFirstEcvposeOfVersion[] = {"0.0 (prototype)", "0.1.0"};
+const char* const kFirstEcvposeOfVersion[] = {"0.0 (prototype)", "0.1.0", "0.2.0"};
 static_assert(sizeof(kFirstEcvposeOfVersion) / sizeof(kFirstEcvposeOfVersion[0]) == kModelDbSchemaVersion + 1,
               "name the ecvpose version that introduces each schema version");
 
@@ -73,6 +74,15 @@ CREATE TABLE color_matrices (
   created TEXT NOT NULL) STRICT;
 )sql";
 
+// Version 2: each model's mesh as rendered (object frame, metres; io/mesh_blob.h), with the SHA-256 of its bytes.
+// A model stored by an older ecvpose has no row: its mesh is read from mesh_path.
+const char* const kMeshesTable = R"sql(
+CREATE TABLE meshes (
+  model_id INTEGER PRIMARY KEY REFERENCES models(id) ON DELETE CASCADE,
+  sha256 TEXT NOT NULL,
+  data BLOB NOT NULL) STRICT;
+)sql";
+
 // Tables of the prototype layout (user_version 0, no application id): models without the symmetric flag,
 // build options, counts and descriptor digest; no colour matrices; settings in a `settings` table.
 const std::vector<std::string> kPrototypeTables = {"descriptors", "models", "primitives", "settings", "views"};
@@ -129,6 +139,11 @@ ALTER TABLE models_v1 RENAME TO models;
   }
 }
 
+// Step 1 -> 2: the meshes table, empty (models already stored keep reading their mesh files).
+void AddMeshesTable(SqlConnection& connection) {
+  connection.Execute(kMeshesTable);
+}
+
 }  // namespace
 
 SchemaState InspectSchema(SqlConnection& connection) {
@@ -175,6 +190,7 @@ void CreateSchema(SqlConnection& connection) {
   connection.Execute(kModelsTable);
   connection.Execute(kViewTables);
   connection.Execute(kMetaAndColorTables);
+  connection.Execute(kMeshesTable);
   WriteVersionMeta(connection);
   transaction.Commit();
 }
@@ -183,6 +199,8 @@ const std::vector<MigrationStep>& MigrationSteps() {
   static const std::vector<MigrationStep> steps = {
       {0, "0 -> 1: prototype layout to the first release (symmetric flag, counts, descriptor digest, colour matrices)",
        MigrateFromPrototype},
+      {1, "1 -> 2: a table for the models' meshes (models stored before keep reading their mesh files)",
+       AddMeshesTable},
   };
   return steps;
 }

@@ -9,7 +9,7 @@
 namespace ecv {
 
 /// Schema version this ecvpose writes and reads (SQLite `PRAGMA user_version`).
-inline constexpr int kModelDbSchemaVersion = 1;
+inline constexpr int kModelDbSchemaVersion = 2;
 
 /// `PRAGMA application_id` of an ecvpose model library ("ECVP").
 inline constexpr int kModelDbApplicationId = 0x45435650;

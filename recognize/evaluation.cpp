@@ -11,17 +11,12 @@
 #include "core/error.h"
 #include "core/point_index.h"
 #include "io/frame_io.h"
-#include "io/mesh_io.h"
 #include "io/pose_io.h"
 
 namespace ecv {
 
 EvalModel EvalModelFromRecord(const ModelRecord& record, size_t max_points) {
-  MeshLoadOptions load;
-  load.metres_per_unit = MetresPerUnit(record.unit);
-  load.object_from_mesh = record.object_from_mesh;
-  load.allow_missing_textures = true;
-  const TriangleMesh mesh = LoadMesh(record.mesh_path, load);
+  const TriangleMesh mesh = ModelMesh(record, /*with_textures=*/false);
   EvalModel model;
   model.name = record.name;
   model.diameter_m = record.diameter_m;

@@ -1,5 +1,6 @@
 // `ecvpose recognize --db lib.sqlite FRAME`: finds the library's objects in an RGB-D frame.
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -128,7 +129,11 @@ int RunRecognize(const RecognizeArgs& args) {
             << args.db << " (" << std::fixed << std::setprecision(0) << library.timings().read_ms << " ms)\n";
   const Clock::time_point setup = Clock::now();
   Recognizer recognizer(library, args.options);
-  std::cerr << "recognize: meshes loaded for verification (" << MillisecondsSince(setup) << " ms)\n";
+  const auto stored = std::count_if(library.models().begin(), library.models().end(),
+                                    [](const LibraryModel& model) { return !model.record.mesh_blob.empty(); });
+  std::cerr << "recognize: meshes loaded for verification (" << stored << " stored in the library, "
+            << library.models().size() - static_cast<size_t>(stored) << " from mesh files; " << MillisecondsSince(setup)
+            << " ms)\n";
 
   if (single) {
     const LoadedFrame& loaded = *single;

@@ -21,7 +21,6 @@
 #include "core/timing.h"
 #include "ecv/descriptor.h"
 #include "ecv/primitives.h"
-#include "io/mesh_io.h"
 #include "io/pose_io.h"
 #include "modeldb/model_builder.h"
 #include "recognize/scoring.h"
@@ -244,19 +243,16 @@ class Recognizer::Impl {
     options_.match.k = 1;
     const std::vector<LibraryModel>& models = library_.models();
     records_.resize(models.size());
-    // Colour mapping, mesh files and texture decoding on every thread, a batch of models at a time (only a
-    // batch's meshes are held at once); the GL uploads on this thread, whose GL context it is.
+    // Colour mapping, stored meshes (or mesh files) and texture decoding on every thread, a batch of models at a time
+    // (only a batch's meshes are held at once); the GL uploads on this thread, whose GL context it is.
     const size_t batch = static_cast<size_t>(options_.ransac.threads);
     std::vector<char> closed(models.size(), 0);  // per model: TriangleMesh::IsClosedOutward
     for (size_t first = 0; first < models.size(); first += batch) {
       std::vector<TriangleMesh> meshes(std::min(batch, models.size() - first));
       ParallelFor(meshes.size(), options_.ransac.threads, [&](size_t i) {
         records_[first + i] = PreparedRecord(models[first + i]);
-        MeshLoadOptions load;
-        load.metres_per_unit = MetresPerUnit(records_[first + i].unit);
-        load.object_from_mesh = records_[first + i].object_from_mesh;
-        load.allow_missing_textures = true;
-        meshes[i] = LoadMesh(records_[first + i].mesh_path, load);
+        meshes[i] = ModelMesh(records_[first + i]);
+        records_[first + i].mesh_blob = {};  // the renderer holds the mesh from here on
         closed[first + i] = meshes[i].IsClosedOutward() ? 1 : 0;
       });
       for (const TriangleMesh& mesh : meshes) meshes_.push_back(renderer_.AddMesh(mesh));

@@ -70,6 +70,15 @@ TEST_F(BuiltModel, RecordsTheMeshTheViewsAndTheSettings) {
   EXPECT_EQ(record.mesh_sha256, Sha256OfFiles(MeshContentFiles(CrackerBox().mesh_path, mesh)));
   EXPECT_EQ(MeshContentFiles(CrackerBox().mesh_path, mesh).size(), 2U);  // the OBJ and its JPEG texture
   EXPECT_TRUE(record.object_from_mesh.isApprox(CrackerBox().object_from_mesh, 0.0));
+  // The mesh is stored as loaded, in the object frame (its 1024 px texture under the 2048 px cap: as it is).
+  const TriangleMesh stored = ModelMesh(record);
+  ASSERT_EQ(stored.parts.size(), mesh.parts.size());
+  EXPECT_EQ(stored.parts[0].positions, mesh.parts[0].positions);
+  EXPECT_EQ(stored.parts[0].texcoords, mesh.parts[0].texcoords);
+  EXPECT_EQ(stored.parts[0].triangles, mesh.parts[0].triangles);
+  ASSERT_EQ(stored.materials.size(), mesh.materials.size());
+  const size_t m = static_cast<size_t>(mesh.parts[0].material);
+  EXPECT_EQ(cv::norm(stored.materials.at(m).texture, mesh.materials.at(m).texture, cv::NORM_INF), 0.0);
   for (const ModelView& view : record.views) {
     EXPECT_EQ(view.camera.width, 320);
     EXPECT_GT(view.primitives.size(), 100U) << "view " << view.index;

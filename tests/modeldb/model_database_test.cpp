@@ -223,6 +223,41 @@ TEST(ModelDatabase, VerifyFindsChangedDescriptorsAndOrphans) {
   EXPECT_THAT(report.problems, Contains(HasSubstr("2 views stored, 1 present")));
 }
 
+// The mesh bytes go in and out as they are, with the model's transaction: replaced with it, removed with it, and
+// checked against their digest by verify.
+TEST(ModelDatabase, StoresAModelsMeshWithItAndVerifiesItsDigest) {
+  test::TemporaryDirectory directory;
+  const std::string path = directory.File("lib.sqlite");
+  ModelRecord a = test::SyntheticModel("a", 2, 30, 1);
+  for (int i = 0; i < 5000; ++i) a.mesh_blob.push_back(static_cast<unsigned char>(i * 7));
+  {
+    ModelDatabase database(path, OpenMode::kCreate);
+    database.AddModel(a);
+    database.AddModel(test::SyntheticModel("b", 1, 30, 2));  // without a stored mesh
+    const std::vector<StoredModel> loaded = database.LoadModels();
+    ASSERT_EQ(loaded.size(), 2U);
+    EXPECT_EQ(loaded[0].record.mesh_blob, a.mesh_blob);
+    EXPECT_TRUE(loaded[1].record.mesh_blob.empty());
+    EXPECT_EQ(database.FindModel("a")->mesh_blob_bytes, 5000);
+    EXPECT_EQ(database.FindModel("b")->mesh_blob_bytes, 0);
+    EXPECT_TRUE(database.Verify().ok());
+  }
+  SqlConnection(path, SqlOpenMode::kReadWrite, 1000).Execute("UPDATE meshes SET data = zeroblob(5000)");
+  EXPECT_THAT(ModelDatabase(path, OpenMode::kReadOnly).Verify().problems,
+              Contains(HasSubstr("model a: stored mesh differs")));
+
+  ModelDatabase database(path, OpenMode::kReadWrite);
+  a.mesh_blob.resize(100);
+  database.AddModel(a);  // replaced whole, its mesh too
+  EXPECT_EQ(database.FindModel("a")->mesh_blob_bytes, 100);
+  EXPECT_TRUE(database.Verify().ok());
+  database.RemoveModel("a");
+  SqlConnection raw(path, SqlOpenMode::kReadOnly, 1000);
+  SqlStatement rows = raw.Prepare("SELECT count(*) FROM meshes");
+  ASSERT_TRUE(rows.Step());
+  EXPECT_EQ(rows.Int(0), 0);
+}
+
 TEST(ModelDatabase, NamesWhatIsWrongWithABadFile) {
   test::TemporaryDirectory directory;
   const std::string text = directory.File("notes.sqlite");
@@ -259,13 +294,13 @@ TEST(ModelDatabase, RefusesANewerSchemaNamingTheVersionNeeded) {
   }
   for (const OpenMode mode : {OpenMode::kReadOnly, OpenMode::kReadWrite, OpenMode::kCreate}) {
     EXPECT_THAT(InputErrorOf([&] { ModelDatabase(path, mode); }),
-                AllOf(HasSubstr(path), HasSubstr("schema version 7"), HasSubstr("up to 1"),
+                AllOf(HasSubstr(path), HasSubstr("schema version 7"), HasSubstr("up to 2"),
                       HasSubstr("ecvpose 0.9.0 or newer")));
   }
   EXPECT_THAT(InputErrorOf([&] { MigrateModelDatabase(path); }), HasSubstr("schema version 7"));
 }
 
-TEST(ModelDatabase, MigratesThePrototypeLayoutInOneStep) {
+TEST(ModelDatabase, MigratesThePrototypeLayoutInOneTransaction) {
   test::TemporaryDirectory directory;
   const std::string path = directory.File("old.sqlite");
   const ModelRecord a = test::SyntheticModel("a", 2, 60, 1);
@@ -278,7 +313,7 @@ TEST(ModelDatabase, MigratesThePrototypeLayoutInOneStep) {
   const ModelDbMigration migration = MigrateModelDatabase(path);
   EXPECT_EQ(migration.from_version, 0);
   EXPECT_EQ(migration.to_version, kModelDbSchemaVersion);
-  EXPECT_EQ(migration.steps.size(), 1U);
+  EXPECT_EQ(migration.steps.size(), 2U);                  // 0 -> 1 -> 2
   EXPECT_TRUE(MigrateModelDatabase(path).steps.empty());  // nothing left to do
 
   ModelDatabase database(path, OpenMode::kReadWrite);
@@ -296,6 +331,37 @@ TEST(ModelDatabase, MigratesThePrototypeLayoutInOneStep) {
   database.SetColorMatrix("a", {});  // the tables of version 1 are there
   database.AddModel(test::SyntheticModel("c", 1, 10, 3));
   EXPECT_EQ(database.ListModels().size(), 3U);
+}
+
+// A library written before meshes were stored (version 1): refused until migrated; its models then read their mesh
+// files (no stored mesh), and new models store theirs.
+TEST(ModelDatabase, MigratesAVersionOneLibraryByAddingTheMeshesTable) {
+  test::TemporaryDirectory directory;
+  const std::string path = directory.File("v1.sqlite");
+  const ModelRecord a = test::SyntheticModel("a", 2, 40, 1);
+  ModelDatabase(path, OpenMode::kCreate).AddModel(a);
+  SqlConnection(path, SqlOpenMode::kReadWrite, 1000)
+      .Execute(
+          "DROP TABLE meshes; PRAGMA user_version = 1; UPDATE meta SET value = '0.1.0' WHERE key = "
+          "'min_ecvpose_version'");
+  EXPECT_THAT(InputErrorOf([&] { ModelDatabase(path, OpenMode::kReadOnly); }),
+              AllOf(HasSubstr("schema version 1"), HasSubstr("ecvpose modeldb migrate --db " + path)));
+
+  const ModelDbMigration migration = MigrateModelDatabase(path);
+  EXPECT_EQ(migration.from_version, 1);
+  EXPECT_EQ(migration.to_version, 2);
+  ASSERT_EQ(migration.steps.size(), 1U);
+  EXPECT_THAT(migration.steps[0], HasSubstr("meshes"));
+  ModelDatabase database(path, OpenMode::kReadWrite);
+  EXPECT_TRUE(database.Verify().ok());
+  const std::vector<StoredModel> loaded = database.LoadModels();
+  ASSERT_EQ(loaded.size(), 1U);
+  EXPECT_EQ(test::CompareViews(a.views, loaded[0].record.views), "");
+  EXPECT_TRUE(loaded[0].record.mesh_blob.empty());
+  ModelRecord b = test::SyntheticModel("b", 1, 20, 2);
+  b.mesh_blob = {1, 2, 3};
+  database.AddModel(b);
+  EXPECT_EQ(database.FindModel("b")->mesh_blob_bytes, 3);
 }
 
 TEST(ModelDatabase, AFailedMigrationLeavesTheOldFileAsItWas) {

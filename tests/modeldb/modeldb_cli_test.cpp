@@ -225,7 +225,7 @@ TEST_F(ModeldbCli, RefusesFilesThatAreNotLibrariesOfThisVersion) {
   SqlConnection(newer, SqlOpenMode::kReadWrite, 1000).Execute("PRAGMA user_version = 9");
   const test::CommandResult refused = test::RunCli("modeldb list --db " + newer);
   EXPECT_EQ(refused.exit_code, 1);
-  EXPECT_THAT(refused.output, AllOf(HasSubstr("schema version 9"), HasSubstr("ecvpose 0.1.0 or newer")));
+  EXPECT_THAT(refused.output, AllOf(HasSubstr("schema version 9"), HasSubstr("ecvpose 0.2.0 or newer")));
 
   const std::string old = scratch_.File("old.sqlite");
   test::WritePrototypeLibrary(old, {test::SyntheticModel("a", 2, 20, 1)});
@@ -234,7 +234,7 @@ TEST_F(ModeldbCli, RefusesFilesThatAreNotLibrariesOfThisVersion) {
   EXPECT_THAT(needs_migration.output, HasSubstr("run `ecvpose modeldb migrate --db " + old + "`"));
   const test::CommandResult migrated = test::RunCli("modeldb migrate --db " + old);
   EXPECT_EQ(migrated.exit_code, 0) << migrated.output;
-  EXPECT_THAT(migrated.output, HasSubstr("from schema version 0 to 1"));
+  EXPECT_THAT(migrated.output, HasSubstr("from schema version 0 to 2"));
   EXPECT_EQ(test::RunCli("modeldb list --db " + old).exit_code, 0);
 }
 

@@ -1,0 +1,217 @@
+// A mesh packed into one byte string and back: see mesh_blob.h for the layout.
+
+#include "io/mesh_blob.h"
+
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/error.h"
+
+namespace ecv {
+namespace {
+
+static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "mesh blobs are written in the host's byte order");
+
+constexpr char kMagic[8] = {'E', 'C', 'V', 'M', 'E', 'S', 'H', '1'};
+constexpr uint32_t kHasNormals = 1U, kHasTexcoords = 2U, kHasColors = 4U;
+
+class BlobWriter {
+ public:
+  void Bytes(const void* data, size_t size) {
+    const auto* bytes = static_cast<const unsigned char*>(data);
+    out_.insert(out_.end(), bytes, bytes + size);
+  }
+  void U32(uint32_t value) { Bytes(&value, sizeof(value)); }
+  void I32(int32_t value) { Bytes(&value, sizeof(value)); }
+  void F32(float value) { Bytes(&value, sizeof(value)); }
+  void String(const std::string& text) {
+    U32(static_cast<uint32_t>(text.size()));
+    Bytes(text.data(), text.size());
+  }
+  template <typename Vector>
+  void Array(const std::vector<Vector>& values) {  // Eigen fixed-size vectors of float or int, packed
+    if (!values.empty()) Bytes(values.front().data(), values.size() * sizeof(Vector));
+  }
+  std::vector<unsigned char> Take() { return std::move(out_); }
+
+ private:
+  std::vector<unsigned char> out_;
+};
+
+class BlobReader {
+ public:
+  BlobReader(const unsigned char* data, size_t size, std::string source)
+      : data_(data), size_(size), source_(std::move(source)) {}
+
+  const unsigned char* Bytes(size_t size, const char* field) {
+    if (size > size_ - offset_) {
+      ThrowInputError(source_, field, std::to_string(size) + " more bytes of the mesh",
+                      std::to_string(size_ - offset_) + " left at byte " + std::to_string(offset_));
+    }
+    const unsigned char* at = data_ + offset_;
+    offset_ += size;
+    return at;
+  }
+  uint32_t U32(const char* field) { return Read<uint32_t>(field); }
+  int32_t I32(const char* field) { return Read<int32_t>(field); }
+  float F32(const char* field) { return Read<float>(field); }
+  std::string String(const char* field) {
+    const uint32_t size = U32(field);
+    return {reinterpret_cast<const char*>(Bytes(size, field)), size};
+  }
+  template <typename Vector>
+  std::vector<Vector> Array(size_t count, const char* field) {
+    if (count > (size_ - offset_) / sizeof(Vector)) Bytes(count * sizeof(Vector), field);  // throws: cut short
+    std::vector<Vector> values(count);
+    if (count > 0) std::memcpy(values.front().data(), Bytes(count * sizeof(Vector), field), count * sizeof(Vector));
+    return values;
+  }
+  /// A count of items that take at least `min_bytes` each: more than the bytes left can hold is corrupt.
+  uint32_t Count(const char* field, size_t min_bytes) {
+    const uint32_t count = U32(field);
+    if (count > (size_ - offset_) / min_bytes) {
+      ThrowInputError(source_, field, "at most " + std::to_string((size_ - offset_) / min_bytes) + " in the bytes left",
+                      std::to_string(count));
+    }
+    return count;
+  }
+  bool AtEnd() const { return offset_ == size_; }
+  const std::string& source() const { return source_; }
+
+ private:
+  template <typename T>
+  T Read(const char* field) {
+    T value;
+    std::memcpy(&value, Bytes(sizeof(T), field), sizeof(T));
+    return value;
+  }
+
+  const unsigned char* data_;
+  size_t size_;
+  size_t offset_ = 0;
+  std::string source_;
+};
+
+void WriteTexture(BlobWriter& writer, const cv::Mat& texture, const MeshBlobOptions& options) {
+  if (texture.empty()) {
+    writer.U32(0);
+    return;
+  }
+  cv::Mat image = texture;
+  const int longest = std::max(texture.cols, texture.rows);
+  if (options.max_texture_size > 0 && longest > options.max_texture_size) {
+    const double scale = static_cast<double>(options.max_texture_size) / longest;
+    cv::resize(texture, image, cv::Size(), scale, scale, cv::INTER_AREA);
+  }
+  cv::Mat bgr;
+  cv::cvtColor(image, bgr, cv::COLOR_RGB2BGR);
+  std::vector<unsigned char> png;
+  cv::imencode(".png", bgr, png, {cv::IMWRITE_PNG_COMPRESSION, options.png_compression});
+  writer.U32(static_cast<uint32_t>(png.size()));
+  writer.Bytes(png.data(), png.size());
+}
+
+cv::Mat ReadTexture(BlobReader& reader, bool decode) {
+  const uint32_t size = reader.U32("texture size");
+  if (size == 0) return {};
+  const unsigned char* png = reader.Bytes(size, "texture");
+  if (!decode) return {};
+  const cv::Mat bytes(1, static_cast<int>(size), CV_8UC1, const_cast<unsigned char*>(png));
+  const cv::Mat bgr = cv::imdecode(bytes, cv::IMREAD_COLOR);
+  if (bgr.empty()) ThrowInputError(reader.source(), "texture", "a PNG image", "bytes that do not decode");
+  cv::Mat rgb;
+  cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
+  return rgb;
+}
+
+void WritePart(BlobWriter& writer, const MeshPart& part) {
+  writer.I32(part.material);
+  writer.U32(static_cast<uint32_t>(part.positions.size()));
+  writer.U32((part.normals.empty() ? 0U : kHasNormals) | (part.texcoords.empty() ? 0U : kHasTexcoords) |
+             (part.colors.empty() ? 0U : kHasColors));
+  writer.U32(static_cast<uint32_t>(part.triangles.size()));
+  writer.Array(part.positions);
+  writer.Array(part.normals);
+  writer.Array(part.texcoords);
+  writer.Array(part.colors);
+  writer.Array(part.triangles);
+}
+
+MeshPart ReadPart(BlobReader& reader, size_t num_materials) {
+  MeshPart part;
+  part.material = reader.I32("part material");
+  if (part.material < -1 || part.material >= static_cast<int>(num_materials)) {
+    ThrowInputError(reader.source(), "part material", "-1 or a material index below " + std::to_string(num_materials),
+                    std::to_string(part.material));
+  }
+  const size_t vertices = reader.U32("part vertices");
+  const uint32_t arrays = reader.U32("part arrays");
+  const size_t triangles = reader.U32("part triangles");
+  part.positions = reader.Array<Eigen::Vector3f>(vertices, "positions");
+  if ((arrays & kHasNormals) != 0) part.normals = reader.Array<Eigen::Vector3f>(vertices, "normals");
+  if ((arrays & kHasTexcoords) != 0) part.texcoords = reader.Array<Eigen::Vector2f>(vertices, "texcoords");
+  if ((arrays & kHasColors) != 0) part.colors = reader.Array<Eigen::Vector3f>(vertices, "colors");
+  part.triangles = reader.Array<Eigen::Vector3i>(triangles, "triangles");
+  for (const Eigen::Vector3i& triangle : part.triangles) {
+    if (triangle.minCoeff() < 0 || triangle.maxCoeff() >= static_cast<int>(vertices)) {
+      ThrowInputError(reader.source(), "triangles", "vertex indices below " + std::to_string(vertices),
+                      std::to_string(triangle.minCoeff()) + ".." + std::to_string(triangle.maxCoeff()));
+    }
+  }
+  return part;
+}
+
+}  // namespace
+
+void MeshBlobOptions::Check() const {
+  if (max_texture_size < 0) {
+    ThrowInputError("mesh blob options", "max_texture_size", ">= 0 pixels (0: no cap)",
+                    std::to_string(max_texture_size));
+  }
+  if (png_compression < 0 || png_compression > 9) {
+    ThrowInputError("mesh blob options", "png_compression", "0 to 9", std::to_string(png_compression));
+  }
+}
+
+std::vector<unsigned char> EncodeMeshBlob(const TriangleMesh& mesh, const MeshBlobOptions& options) {
+  options.Check();
+  BlobWriter writer;
+  writer.Bytes(kMagic, sizeof(kMagic));
+  writer.String(mesh.name);
+  writer.U32(static_cast<uint32_t>(mesh.materials.size()));
+  for (const MeshMaterial& material : mesh.materials) {
+    writer.String(material.name);
+    for (int c = 0; c < 3; ++c) writer.F32(material.diffuse_color[c]);
+    writer.String(material.texture_path);
+    WriteTexture(writer, material.texture, options);
+  }
+  writer.U32(static_cast<uint32_t>(mesh.parts.size()));
+  for (const MeshPart& part : mesh.parts) WritePart(writer, part);
+  return writer.Take();
+}
+
+TriangleMesh DecodeMeshBlob(const unsigned char* data, size_t size, const std::string& source, bool with_textures) {
+  BlobReader reader(data, size, source);
+  if (size < sizeof(kMagic) || std::memcmp(reader.Bytes(sizeof(kMagic), "header"), kMagic, sizeof(kMagic)) != 0) {
+    ThrowInputError(source, "header", "a mesh of format ECVMESH1");
+  }
+  TriangleMesh mesh;
+  mesh.name = reader.String("name");
+  mesh.materials.resize(reader.Count("materials", 24));  // name, colour, path, texture size
+  for (MeshMaterial& material : mesh.materials) {
+    material.name = reader.String("material name");
+    for (int c = 0; c < 3; ++c) material.diffuse_color[c] = reader.F32("diffuse colour");
+    material.texture_path = reader.String("texture path");
+    material.texture = ReadTexture(reader, with_textures);
+  }
+  const uint32_t parts = reader.Count("parts", 16);  // material, vertices, arrays, triangles
+  for (uint32_t p = 0; p < parts; ++p) mesh.parts.push_back(ReadPart(reader, mesh.materials.size()));
+  if (!reader.AtEnd()) ThrowInputError(source, "end", "the mesh's last byte after its last part");
+  return mesh;
+}
+
+}  // namespace ecv
