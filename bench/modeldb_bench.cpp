@@ -453,7 +453,7 @@ int main(int argc, char** argv) {
     const std::string markdown =
         "Textured YCB meshes (google_16k, 4096^2 textures), " + std::to_string(settings.views) +
         " views of 640x480 (YCB-Video camera) per model at the default distance (1 m, farther where the object would "
-        "not fit), default ECV and descriptor settings, the mesh stored with each model (textures at 2048^2, PNG); "
+        "not fit), default ECV and descriptor settings, the mesh stored with each model (textures at 2048^2, LZ4); "
         "one transaction per model. Below them, for comparison, " +
         std::to_string(settings.fit_views) +
         " views per model as close as each object fits the image (the "

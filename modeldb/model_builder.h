@@ -40,8 +40,8 @@ struct ModelBuildOptions {
   bool shade_untextured = true;
   FeatureSettings features;  ///< extraction and descriptor settings
   /// Store the mesh in the record (ModelRecord::mesh_blob), so that recognition verifies poses without the mesh
-  /// file and without decoding its full-size textures: with the 7 YCB models (4096 px PNG textures), see
-  /// bench/RESULTS.md (session 28). Textures are kept up to mesh_blob.max_texture_size (the recognizer's own cap).
+  /// file and without decoding its full-size textures (the 7 YCB models, 4096 px PNG textures: setup_bench in
+  /// bench/RESULTS.md, session 28). Textures are kept up to mesh_blob.max_texture_size (the recognizer's own cap).
   bool store_mesh = true;
   MeshBlobOptions mesh_blob;
   int threads = 1;  ///< worker threads describing each view (ComputeDescriptors); the model does not depend on it

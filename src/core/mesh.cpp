@@ -1,10 +1,10 @@
 #include "core/mesh.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
-#include <map>
+#include <cstdint>
 #include <numeric>
-#include <tuple>
 #include <utility>
 
 namespace ecv {
@@ -79,35 +79,44 @@ double TriangleMesh::Diameter() const {
 }
 
 bool TriangleMesh::IsClosedOutward() const {
-  // Vertices by position: a seam's copies of a vertex become one.
-  std::map<std::tuple<float, float, float>, int> id_of;
-  std::map<std::pair<int, int>, int> directed;  // (from, to) -> how many triangles run through it so
-  double volume6 = 0.0;                         // 6 x the signed volume enclosed
+  // Vertices by position, numbered in sorted order: a seam's copies of a vertex become one.
+  std::vector<std::pair<std::array<float, 3>, size_t>> positions;  // (position, index over all parts)
   for (const MeshPart& part : parts) {
-    std::vector<int> ids(part.positions.size());
-    for (size_t i = 0; i < part.positions.size(); ++i) {
-      const Eigen::Vector3f& p = part.positions[i];
-      ids[i] = id_of.emplace(std::make_tuple(p.x(), p.y(), p.z()), static_cast<int>(id_of.size())).first->second;
-    }
+    for (const Eigen::Vector3f& p : part.positions) positions.push_back({{p.x(), p.y(), p.z()}, positions.size()});
+  }
+  std::sort(positions.begin(), positions.end());
+  std::vector<uint32_t> id_of(positions.size());
+  uint32_t id = 0;
+  for (size_t i = 0; i < positions.size(); ++i) {
+    if (i > 0 && positions[i].first != positions[i - 1].first) ++id;
+    id_of[positions[i].second] = id;
+  }
+  // Every directed edge (from, to) of every triangle, and the same edges reversed: closed when the two multisets
+  // are equal (each edge run through as often in one direction as in the other).
+  std::vector<uint64_t> edges, reversed;
+  double volume6 = 0.0;  // 6 x the signed volume enclosed
+  size_t first = 0;      // of the part's vertices in id_of
+  for (const MeshPart& part : parts) {
     for (const Eigen::Vector3i& triangle : part.triangles) {
-      const int a = ids[static_cast<size_t>(triangle.x())], b = ids[static_cast<size_t>(triangle.y())];
-      const int c = ids[static_cast<size_t>(triangle.z())];
-      if (a == b || b == c || a == c) continue;  // a triangle with two corners at one position covers nothing
-      ++directed[{a, b}];
-      ++directed[{b, c}];
-      ++directed[{c, a}];
+      const uint64_t corner[3] = {id_of[first + static_cast<size_t>(triangle.x())],
+                                  id_of[first + static_cast<size_t>(triangle.y())],
+                                  id_of[first + static_cast<size_t>(triangle.z())]};
+      if (corner[0] == corner[1] || corner[1] == corner[2] || corner[0] == corner[2]) continue;  // covers nothing
+      for (int k = 0; k < 3; ++k) {
+        edges.push_back(corner[k] << 32 | corner[(k + 1) % 3]);
+        reversed.push_back(corner[(k + 1) % 3] << 32 | corner[k]);
+      }
       const Eigen::Vector3d p = part.positions[static_cast<size_t>(triangle.x())].cast<double>();
       const Eigen::Vector3d q = part.positions[static_cast<size_t>(triangle.y())].cast<double>();
       const Eigen::Vector3d r = part.positions[static_cast<size_t>(triangle.z())].cast<double>();
       volume6 += p.dot(q.cross(r));
     }
+    first += part.positions.size();
   }
-  if (directed.empty()) return false;
-  for (const auto& [edge, count] : directed) {
-    const auto reverse = directed.find({edge.second, edge.first});
-    if (reverse == directed.end() || reverse->second != count) return false;
-  }
-  return volume6 > 0.0;
+  if (edges.empty()) return false;
+  std::sort(edges.begin(), edges.end());
+  std::sort(reversed.begin(), reversed.end());
+  return edges == reversed && volume6 > 0.0;
 }
 
 void TriangleMesh::Transform(const Eigen::Isometry3d& new_from_old) {

@@ -91,8 +91,15 @@ TEST(MeshBlob, BrokenBytesAreReportedByField) {
   MeshPart& part = mesh.parts.emplace_back();
   part.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
   part.triangles = {{0, 1, 2}, {0, 2, 3}};
+  part.texcoords = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  part.material = 0;
+  MeshMaterial& material = mesh.materials.emplace_back();
+  material.texture = cv::Mat(6, 8, CV_8UC3);
+  cv::randu(material.texture, 0, 256);
   const std::vector<unsigned char> blob = EncodeMeshBlob(mesh);
-  EXPECT_EQ(RoundTrip(mesh).parts.at(0).triangles, part.triangles);
+  const TriangleMesh decoded = RoundTrip(mesh);
+  EXPECT_EQ(decoded.parts.at(0).triangles, part.triangles);
+  EXPECT_TRUE(SameImages(decoded.materials.at(0).texture, material.texture));
 
   auto error_of = [](std::vector<unsigned char> bytes) -> std::string {
     try {
@@ -112,12 +119,17 @@ TEST(MeshBlob, BrokenBytesAreReportedByField) {
   std::vector<unsigned char> index = blob;
   index[index.size() - 4] = 9;  // the last triangle's last index: 3 -> 9
   EXPECT_NE(error_of(index).find("triangles: expected vertex indices below 4"), std::string::npos) << error_of(index);
+  std::vector<unsigned char> wide = blob;  // the texture's width, after the name, material count, name, colour, path
+  const size_t width_at = 8 + 4 + mesh.name.size() + 4 + 4 + 12 + 4;
+  ASSERT_EQ(wide[width_at], 8);
+  wide[width_at] = 9;  // 9 x 6 pixels where the data holds 8 x 6
+  EXPECT_NE(error_of(wide).find("texture: expected LZ4 data of 9 x 6 RGB pixels"), std::string::npos) << error_of(wide);
   std::vector<unsigned char> longer = blob;
   longer.push_back(0);
   EXPECT_NE(error_of(longer).find("end"), std::string::npos);
 
   MeshBlobOptions bad;
-  bad.png_compression = 10;
+  bad.lz4_level = 13;
   EXPECT_THROW(EncodeMeshBlob(mesh, bad), InputError);
   bad = {};
   bad.max_texture_size = -1;

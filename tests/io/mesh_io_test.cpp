@@ -86,6 +86,19 @@ TEST(MeshIo, LmoPlysLoadWithVertexColoursInMetresAndBopDiameters) {
   EXPECT_EQ(checked, 8);
 }
 
+// Which real meshes close outwards (verification renders skip their back faces): every textured YCB mesh and the
+// YCB-Video banana; 6 of the 8 LM-O scans, the can (obj_000005) and the eggbox (obj_000010) having open edges.
+TEST(MeshIo, RealMeshesCloseOutwardsButTwoLmoScans) {
+  for (const char* name : kTexturedYcb) EXPECT_TRUE(LoadMesh(TexturedObj(name)).IsClosedOutward()) << name;
+  EXPECT_TRUE(LoadMesh(test::DataPath("ycbv_subset/models/011_banana/textured_simple.obj")).IsClosedOutward());
+  for (const int id : {1, 5, 6, 8, 9, 10, 11, 12}) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "obj_%06d.ply", id);
+    const TriangleMesh mesh = LoadMesh(test::DataPath(std::string("lmo_subset/data/bop/lmo/models/") + name));
+    EXPECT_EQ(mesh.IsClosedOutward(), id != 5 && id != 10) << name;
+  }
+}
+
 TEST(MeshIo, MissingTextureIsAllowedOnRequestWithAWarning) {
   const std::string path = test::DataPath("ycbv_subset/models/003_cracker_box/textured_simple.obj");
   MeshLoadOptions options;
