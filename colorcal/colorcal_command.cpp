@@ -166,13 +166,19 @@ int RunAuto(const ColorcalArgs& args) {
   }
   if (specs.empty()) specs.push_back(args.frame);
 
-  MeshLoadOptions mesh_options;
-  mesh_options.metres_per_unit = MetresPerUnit(model.unit);
-  mesh_options.object_from_mesh = model.object_from_mesh;
-  mesh_options.allow_missing_textures = true;
-  std::vector<std::string> warnings;
-  const TriangleMesh mesh = LoadMesh(model.mesh_path, mesh_options, &warnings);
-  for (const std::string& warning : warnings) std::cerr << "ecvpose: warning: " << warning << '\n';
+  // The mesh as the recognizer verifies with it: stored in the library, or (a model stored without) its file.
+  TriangleMesh mesh;
+  if (model.mesh_blob_bytes > 0) {
+    mesh = ModelMesh(database.LoadModels({args.model}).at(0).record);
+  } else {
+    MeshLoadOptions mesh_options;
+    mesh_options.metres_per_unit = MetresPerUnit(model.unit);
+    mesh_options.object_from_mesh = model.object_from_mesh;
+    mesh_options.allow_missing_textures = true;
+    std::vector<std::string> warnings;
+    mesh = LoadMesh(model.mesh_path, mesh_options, &warnings);
+    for (const std::string& warning : warnings) std::cerr << "ecvpose: warning: " << warning << '\n';
+  }
   Renderer renderer;
   const MeshId id = renderer.AddMesh(mesh);
 
