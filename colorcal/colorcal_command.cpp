@@ -17,7 +17,6 @@
 #include "colorcal/pairs_csv.h"
 #include "core/error.h"
 #include "io/frame_io.h"
-#include "io/mesh_io.h"
 #include "io/pose_io.h"
 #include "modeldb/model_database.h"
 #include "render/renderer.h"
@@ -154,7 +153,7 @@ std::vector<ColorPair> PairsInFrame(const ColorcalArgs& args, const FrameSpec& s
 
 int RunAuto(const ColorcalArgs& args) {
   ModelDatabase database(args.db, OpenMode::kReadWrite);
-  const ModelSummary model = FindModelOrThrow(database, args.model);
+  FindModelOrThrow(database, args.model);  // before reading frames: a wrong name fails at once
   if (args.frames.size() > 1 && !args.pose_path.empty()) {
     throw InputError("--pose " + args.pose_path + " is one frame's pose, but " + std::to_string(args.frames.size()) +
                      " frames were given: use frames with ground truth, or one frame");
@@ -166,19 +165,10 @@ int RunAuto(const ColorcalArgs& args) {
   }
   if (specs.empty()) specs.push_back(args.frame);
 
-  // The mesh as the recognizer verifies with it: stored in the library, or (a model stored without) its file.
-  TriangleMesh mesh;
-  if (model.mesh_blob_bytes > 0) {
-    mesh = ModelMesh(database.LoadModels({args.model}).at(0).record);
-  } else {
-    MeshLoadOptions mesh_options;
-    mesh_options.metres_per_unit = MetresPerUnit(model.unit);
-    mesh_options.object_from_mesh = model.object_from_mesh;
-    mesh_options.allow_missing_textures = true;
-    std::vector<std::string> warnings;
-    mesh = LoadMesh(model.mesh_path, mesh_options, &warnings);
-    for (const std::string& warning : warnings) std::cerr << "ecvpose: warning: " << warning << '\n';
-  }
+  // The mesh the recognizer verifies with: stored in the library, or (a model stored without) its file.
+  std::vector<std::string> warnings;
+  const TriangleMesh mesh = ModelMesh(database.LoadModels({args.model}).at(0).record, true, &warnings);
+  for (const std::string& warning : warnings) std::cerr << "ecvpose: warning: " << warning << '\n';
   Renderer renderer;
   const MeshId id = renderer.AddMesh(mesh);
 

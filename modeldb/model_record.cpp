@@ -114,7 +114,7 @@ std::string ModelRecord::DescriptorSha256() const {
   return hash.HexDigest();
 }
 
-TriangleMesh ModelMesh(const ModelRecord& record, bool with_textures) {
+TriangleMesh ModelMesh(const ModelRecord& record, bool with_textures, std::vector<std::string>* warnings) {
   if (!record.mesh_blob.empty()) {
     return DecodeMeshBlob(record.mesh_blob.data(), record.mesh_blob.size(), "model " + record.name + ": stored mesh",
                           with_textures);
@@ -123,7 +123,7 @@ TriangleMesh ModelMesh(const ModelRecord& record, bool with_textures) {
   load.metres_per_unit = MetresPerUnit(record.unit);
   load.object_from_mesh = record.object_from_mesh;
   load.allow_missing_textures = true;
-  return LoadMesh(record.mesh_path, load);
+  return LoadMesh(record.mesh_path, load, warnings);
 }
 
 }  // namespace ecv

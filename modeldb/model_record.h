@@ -70,8 +70,10 @@ struct ModelRecord {
 /// The mesh of a library model in the object frame (metres): the stored one (mesh_blob) when there is one, else
 /// its mesh file (mesh_path with the record's unit and object_from_mesh; missing textures tolerated, as in the
 /// build). Without `with_textures`, geometry alone (a stored mesh's textures are not decoded). Throws InputError
-/// naming the model for stored bytes that do not decode, or the file for one that cannot be read.
-TriangleMesh ModelMesh(const ModelRecord& record, bool with_textures = true);
+/// naming the model for stored bytes that do not decode, or the file for one that cannot be read; `warnings` (may
+/// be null) receives what the file's loader tolerated.
+TriangleMesh ModelMesh(const ModelRecord& record, bool with_textures = true,
+                       std::vector<std::string>* warnings = nullptr);
 
 /// A 3x3 colour matrix of a model (paper Sect. IV-C): c_scene = model_to_scene * c_model (RGB in [0, 1]).
 struct ColorMatrixRecord {

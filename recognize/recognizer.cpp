@@ -251,8 +251,8 @@ class Recognizer::Impl {
       std::vector<TriangleMesh> meshes(std::min(batch, models.size() - first));
       ParallelFor(meshes.size(), options_.ransac.threads, [&](size_t i) {
         records_[first + i] = PreparedRecord(models[first + i]);
-        meshes[i] = ModelMesh(records_[first + i]);
-        records_[first + i].mesh_blob = {};  // the renderer holds the mesh from here on
+        meshes[i] = ModelMesh(models[first + i].record);
+        records_[first + i].mesh_blob = {};  // the copy's bytes: the renderer holds the mesh
         closed[first + i] = meshes[i].IsClosedOutward() ? 1 : 0;
       });
       for (const TriangleMesh& mesh : meshes) meshes_.push_back(renderer_.AddMesh(mesh));

@@ -89,12 +89,7 @@ GLuint UploadAttribute(const Functions& gl, GLuint location, int size, const flo
 
 GLuint UploadTexture(const Context& context, const cv::Mat& texture, bool mipmaps, int max_texture_size) {
   const Functions& gl = context.functions();
-  cv::Mat image = texture;
-  const int longest = std::max(texture.cols, texture.rows);
-  if (longest > max_texture_size) {
-    const double scale = static_cast<double>(max_texture_size) / longest;
-    cv::resize(texture, image, cv::Size(), scale, scale, cv::INTER_AREA);
-  }
+  cv::Mat image = CapTextureSize(texture, max_texture_size);
   if (!image.isContinuous()) image = image.clone();
   GLuint id = 0;
   gl.GenTextures(1, &id);

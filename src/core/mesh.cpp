@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdint>
 #include <numeric>
+
+#include <opencv2/imgproc.hpp>
 #include <utility>
 
 namespace ecv {
@@ -76,6 +78,15 @@ double TriangleMesh::Diameter() const {
     }
   }
   return std::sqrt(best_squared);
+}
+
+cv::Mat CapTextureSize(const cv::Mat& texture, int max_side) {
+  const int longest = std::max(texture.cols, texture.rows);
+  if (max_side <= 0 || longest <= max_side) return texture;
+  const double scale = static_cast<double>(max_side) / longest;
+  cv::Mat capped;
+  cv::resize(texture, capped, cv::Size(), scale, scale, cv::INTER_AREA);
+  return capped;
 }
 
 bool TriangleMesh::IsClosedOutward() const {

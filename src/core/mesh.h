@@ -32,6 +32,11 @@ struct MeshPart {
   int material = -1;                       ///< index into TriangleMesh::materials, -1 for none
 };
 
+/// `texture` with its longer side at most `max_side` pixels: larger ones are downscaled (cv::INTER_AREA, aspect
+/// kept), others returned as they are (sharing pixels). The one rule of the renderer's texture cap and of stored
+/// meshes (io/mesh_blob.h), so that both give the same pixels; 0 keeps every size.
+cv::Mat CapTextureSize(const cv::Mat& texture, int max_side);
+
 /// A triangle mesh in the object frame (metres), as loaded by io/mesh_io.h.
 struct TriangleMesh {
   std::string name;  ///< file stem unless given

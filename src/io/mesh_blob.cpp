@@ -2,13 +2,11 @@
 
 #include "io/mesh_blob.h"
 
-#include <algorithm>
 #include <cstdint>
 #include <cstring>
 
 #include <lz4.h>
 #include <lz4hc.h>
-#include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
 #include "core/error.h"
@@ -105,12 +103,7 @@ void WriteTexture(BlobWriter& writer, const cv::Mat& texture, const MeshBlobOpti
     writer.U32(0);
     return;
   }
-  cv::Mat image = texture;
-  const int longest = std::max(texture.cols, texture.rows);
-  if (options.max_texture_size > 0 && longest > options.max_texture_size) {
-    const double scale = static_cast<double>(options.max_texture_size) / longest;
-    cv::resize(texture, image, cv::Size(), scale, scale, cv::INTER_AREA);
-  }
+  cv::Mat image = CapTextureSize(texture, options.max_texture_size);
   if (!image.isContinuous()) image = image.clone();
   const int raw = static_cast<int>(image.total() * 3);
   std::vector<char> packed(static_cast<size_t>(LZ4_compressBound(raw)));

@@ -10,8 +10,8 @@ namespace ecv {
 
 /// How a mesh is packed into one self-contained byte string (EncodeMeshBlob), e.g. to keep it in a model library.
 struct MeshBlobOptions {
-  /// Textures larger than this (pixels per side) are stored downscaled (cv::INTER_AREA, as the renderer's own
-  /// cap does): a verification render covers a few hundred pixels of a model. 0 keeps them as they are.
+  /// Textures larger than this (pixels per side) are stored downscaled (CapTextureSize, the renderer's own cap): a
+  /// verification render covers a few hundred pixels of a model. 0 keeps them as they are.
   int max_texture_size = 2048;
   /// LZ4-HC level of the textures' RGB rows (lossless), 1 (fastest to write) to 12 (smallest); decoding is as fast
   /// at any level. At 9 YCB's textures (2048 x 2048) take 1.1-1.5 MB, less than as PNG (1.3-1.7 MB).
