@@ -8,7 +8,7 @@
 // end-to-end runs of recognize_bench. With --lmo, the LM-O frame of recognize_bench instead (its library).
 //
 //   scripts/build_ycbv_library /tmp/ycbv.sqlite --views 40 --distance 0.9
-//   ranking_bench --db /tmp/ycbv.sqlite [--seed 1] [--results bench/RESULTS.md]
+//   ranking_bench --db /tmp/ycbv.sqlite [--seed 1] [--ranking-checks N] [--results bench/RESULTS.md]
 //   scripts/build_lmo_library /tmp/lmo.sqlite --views 40 --distance 1.0
 //   ranking_bench --db /tmp/lmo.sqlite --lmo
 
@@ -150,13 +150,15 @@ int Main(int argc, char** argv) {
       lmo = true;
     } else if (has_value && std::strcmp(argv[i], "--seed") == 0) {
       options.ransac.seed = std::stoull(argv[++i]);
+    } else if (has_value && std::strcmp(argv[i], "--ranking-checks") == 0) {
+      options.ranking_checks = std::stoi(argv[++i]);
     } else {
       db.clear();
       break;
     }
   }
   if (db.empty()) {
-    std::cerr << "usage: ranking_bench --db LIB.sqlite [--lmo] [--seed N] [--results FILE]\n"
+    std::cerr << "usage: ranking_bench --db LIB.sqlite [--lmo] [--seed N] [--ranking-checks N] [--results FILE]\n"
                  "  (LIB: the 7 textured YCB-Video models, scripts/build_ycbv_library LIB --views 40 --distance 0.9;\n"
                  "  with --lmo the LM-O frame, scripts/build_lmo_library LIB --views 40 --distance 1.0)\n";
     return 2;
@@ -167,9 +169,10 @@ int Main(int argc, char** argv) {
   std::ostringstream markdown;
   markdown << "Library `" << db << "` (" << library.models().size() << " models), the " << ms.size()
            << (lmo ? " LM-O frame (scene 000002, image 3)" : " YCB-Video frames") << ", seed " << options.ransac.seed
-           << " (it picks each view's " << options.consistency_max_correspondences
-           << " ranking descriptors), one thread. Right = the ground truth puts the view primitive within "
-           << kRightM * 100.0F << " cm of its scene primitive; good view = " << kGoodView
+           << " (it picks each view's " << options.consistency_max_correspondences << " ranking descriptors, "
+           << options.ranking_checks << " checks per query; 0: as matching, " << options.match.checks
+           << "), one thread. Right = the ground truth puts the view primitive within " << kRightM * 100.0F
+           << " cm of its scene primitive; good view = " << kGoodView
            << " or more right. Score = the ranking's consistent-set size. Median ms per frame for describing the "
               "scene and ranking every view: "
            << Fixed(Median(ms), 0) << ".\n\n"

@@ -197,7 +197,7 @@ std::string RecallTable(const Runs& runs) {
 std::string TimingTable(const Run& run) {
   std::ostringstream out;
   out << "| stage | median ms per frame | mean ms per frame |\n|---|---:|---:|\n";
-  for (const char* stage : {"extract", "describe", "track", "match", "ransac", "verify", "refine", "total"}) {
+  for (const char* stage : {"extract", "describe", "track", "rank", "match", "ransac", "verify", "refine", "total"}) {
     const auto found = run.stage_ms.find(stage);
     if (found != run.stage_ms.end()) {
       out << "| " << stage << " | " << Fixed(Median(found->second), 1) << " | " << Fixed(Mean(found->second), 1)

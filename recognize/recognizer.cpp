@@ -209,6 +209,7 @@ void RecognizerOptions::Check() const {
   consistency.Check();
   plane_patch.Check();
   require(consistency_max_correspondences >= 3, "consistency_max_correspondences", "at least 3");
+  require(ranking_checks >= 0, "ranking_checks", "0 (match.checks) or more");
   require(dense_stride_px >= 1, "dense_stride_px", "at least 1");
   require(ransac_stride_px >= 1, "ransac_stride_px", "at least 1");
   require(icp_max_points >= 0, "icp_max_points", ">= 0 (0: all)");
@@ -347,7 +348,7 @@ class Recognizer::Impl {
       const Clock::time_point ranking = Clock::now();
       // A view's other descriptors are matched when it is tried (Try): views after a good enough one are not.
       std::vector<ViewCandidate> ranked = ScoreViews(m, scene);
-      model_timings[m]["match"] += MillisecondsSince(ranking);
+      model_timings[m]["rank"] += MillisecondsSince(ranking);
       while (instances(m) < options_.max_instances) {
         // Once an instance is found the model is known to be in the frame: more of its views are worth trying.
         const int views = instances(m) == 0 || options_.later_instance_views == 0 ? options_.views_per_model
@@ -539,7 +540,7 @@ class Recognizer::Impl {
       candidate.view = static_cast<int>(v);
       // Scored on a seeded subset of the view's descriptors, for speed.
       candidate.correspondences =
-          Correspondences(view, CopyRows(view.descriptors, RankingRows(model, v).ranking), scene);
+          Correspondences(view, CopyRows(view.descriptors, RankingRows(model, v).ranking), scene, RankingChecks());
       ConsistencyOptions consistency = options_.consistency;
       consistency.max_distance_m = record.diameter_m;
       candidate.score = ConsistentSetSize(view.primitives, scene.primitives, candidate.correspondences, consistency);
@@ -556,17 +557,25 @@ class Recognizer::Impl {
                      static_cast<size_t>(options_.consistency_max_correspondences), options_.ransac.seed + view);
   }
 
+  // Compared descriptors per ranking query.
+  int RankingChecks() const { return options_.ranking_checks > 0 ? options_.ranking_checks : options_.match.checks; }
+
   // Gives `candidate` its correspondences, once: the nearest scene descriptor of each of its descriptors (paper:
-  // object to scene). The ranking has matched a subset of them; only the others are searched here, and the
-  // correspondences are put in the order in which matching all the rows at once gives them (MatchOrderLess), so
-  // that RANSAC draws the same samples.
+  // object to scene). The ranking has matched a subset of them; when it searched as matching does, only the
+  // others are searched here. The correspondences are put in the order in which matching all the rows at once
+  // gives them (MatchOrderLess), so that RANSAC draws the same samples.
   void Match(size_t model, const Scene& scene, ViewCandidate* candidate) const {
     if (candidate->matched) return;
     const auto view = static_cast<size_t>(candidate->view);
     const ModelView& model_view = records_[model].views[view];
-    std::vector<Correspondence> found =
-        Correspondences(model_view, CopyRows(model_view.descriptors, RankingRows(model, view).rest), scene);
-    found.insert(found.end(), candidate->correspondences.begin(), candidate->correspondences.end());
+    const bool reuse_ranking = RankingChecks() == options_.match.checks;
+    std::vector<Correspondence> found;
+    if (reuse_ranking) {
+      found = Correspondences(model_view, CopyRows(model_view.descriptors, RankingRows(model, view).rest), scene);
+      found.insert(found.end(), candidate->correspondences.begin(), candidate->correspondences.end());
+    } else {
+      found = Correspondences(model_view, model_view.descriptors, scene);
+    }
     std::sort(found.begin(), found.end(), [&](const Correspondence& a, const Correspondence& b) {
       return MatchOrderLess(model_view.primitives, options_.match.structure_specific, a.object, b.object);
     });
@@ -574,11 +583,11 @@ class Recognizer::Impl {
     candidate->matched = true;
   }
 
-  // The nearest scene primitive of each of `descriptors` (rows of the view's).
+  // The nearest scene primitive of each of `descriptors` (rows of the view's); `checks` > 0 replaces match.checks.
   static std::vector<Correspondence> Correspondences(const ModelView& view, const Descriptors& descriptors,
-                                                     const Scene& scene) {
+                                                     const Scene& scene, int checks = 0) {
     std::vector<Correspondence> found;
-    for (const DescriptorMatch& match : scene.matcher->Match(view.primitives, descriptors)) {
+    for (const DescriptorMatch& match : scene.matcher->Match(view.primitives, descriptors, checks)) {
       if (match.rank == 0) found.push_back({match.query, match.train});
     }
     return found;

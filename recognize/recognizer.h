@@ -78,6 +78,15 @@ struct RecognizerOptions {
   ConsistencyOptions consistency;
   /// Per view, at most this many of its descriptors (a seeded random subset) are matched for the ranking.
   int consistency_max_correspondences = 200;
+  /// Descriptors compared per ranking query (MatchOptions::checks for these; 0: match.checks). Ranking every
+  /// library view is the largest stage, and a view's ranking needs only its consistent set, not each row's exact
+  /// neighbour; a tried view's rows are then all matched again with match.checks. On the 30 YCB-Video frames
+  /// (two threads, RANSAC seeds 1-5, found / false positives of 350): 0 (128) 301 / 6, 64 292 / 12, 32 299 / 5,
+  /// 16 293 / 5; with 32 the ranking took 230 instead of 470 ms per frame (summed over the threads) and the tried
+  /// views' matching 90 instead of 45, but a good view ranked first for 52 instead of 58 of the 70 objects
+  /// (ranking_bench) and the LM-O can was lost (with 48 too; 64 keeps it). Which views are tried decides the
+  /// turned mustard bottle by chance, so recall moves either way: left at 0 (bench/RESULTS.md, session 29).
+  int ranking_checks = 0;
   /// Beyond the paper: a RANSAC sample's later correspondences are drawn near its first one, within this
   /// many model diameters (RansacOptions::sample_radius_m); 0 draws them anywhere in the scene.
   double sample_radius_diameters = 1.0;

@@ -8,6 +8,7 @@
 
 #include <opencv2/flann.hpp>
 
+#include "core/byte_neighbours.h"
 #include "core/error.h"
 #include "core/kd_forest.h"
 #include "core/point_index.h"
@@ -22,8 +23,9 @@ struct DescriptorMatcher::Index {
   std::vector<int> primitive;  // train primitive of each row
   std::unique_ptr<cv::flann::Index> flann;
   std::unique_ptr<KdForest> forest;
+  std::unique_ptr<ByteNeighbours> bytes;
 
-  int rows() const { return forest ? forest->size() : values.rows; }
+  int rows() const { return forest ? forest->size() : bytes ? bytes->size() : values.rows; }
 };
 
 namespace {
@@ -64,7 +66,10 @@ DescriptorMatcher::DescriptorMatcher(const std::vector<Primitive>& train_primiti
         train,
         [&](int i) { return types == 1 || static_cast<int>(train_primitives[static_cast<size_t>(i)].type) == type; },
         &index->values, &index->primitive);
-    if (index->values.rows > 0 && options_.index == MatchIndex::kKdForest) {
+    if (index->values.rows > 0 && options_.index == MatchIndex::kBytes) {
+      index->bytes = std::make_unique<ByteNeighbours>(index->values);
+      index->values.release();
+    } else if (index->values.rows > 0 && options_.index == MatchIndex::kKdForest) {
       KdForestOptions forest;
       forest.trees = options_.trees;
       forest.leaf_size = options_.leaf_size;
@@ -92,7 +97,7 @@ DescriptorMatcher::DescriptorMatcher(const std::vector<Primitive>& train_primiti
 DescriptorMatcher::~DescriptorMatcher() = default;
 
 std::vector<DescriptorMatch> DescriptorMatcher::Match(const std::vector<Primitive>& query_primitives,
-                                                      const Descriptors& query) const {
+                                                      const Descriptors& query, int checks) const {
   std::vector<DescriptorMatch> matches;
   for (size_t type = 0; type < indices_.size(); ++type) {
     const Index& index = *indices_[type];
@@ -108,11 +113,14 @@ std::vector<DescriptorMatch> DescriptorMatcher::Match(const std::vector<Primitiv
     if (values.rows == 0) continue;
     const int k = std::min(options_.k, index.rows());
     cv::Mat neighbours, squared;
-    if (index.forest) {
-      const int checks = index.rows() < options_.exact_below ? index.rows() : options_.checks;
-      index.forest->Search(values, k, checks, &neighbours, &squared);
+    const int approximate_checks = checks > 0 ? checks : options_.checks;
+    if (index.bytes) {
+      index.bytes->Search(values, k, &neighbours, &squared);
+    } else if (index.forest) {
+      const int compared = index.rows() < options_.exact_below ? index.rows() : approximate_checks;
+      index.forest->Search(values, k, compared, &neighbours, &squared);
     } else {
-      index.flann->knnSearch(values, neighbours, squared, k, cv::flann::SearchParams(options_.checks));
+      index.flann->knnSearch(values, neighbours, squared, k, cv::flann::SearchParams(approximate_checks));
     }
     for (int q = 0; q < neighbours.rows; ++q) {
       for (int rank = 0; rank < k; ++rank) {

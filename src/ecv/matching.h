@@ -13,6 +13,9 @@ namespace ecv {
 enum class MatchIndex {
   kFlann,     ///< OpenCV's FLANN: randomised kd-trees with a row per leaf (the paper's matcher)
   kKdForest,  ///< ecvpose's KdForest: the same trees with leaves of leaf_size rows, much less time per check
+  /// ByteNeighbours: every train descriptor compared, values quantised to 7 bits (exact up to that; checks,
+  /// trees and exact_below unused)
+  kBytes,
 };
 
 /// Nearest-neighbour matching of context descriptors.
@@ -48,7 +51,9 @@ class DescriptorMatcher {
 
   /// The k nearest train descriptors of each query descriptor (of the same type when structure-specific), in
   /// MatchOrderLess order: a query set matched in parts gives the same matches once sorted by it.
-  std::vector<DescriptorMatch> Match(const std::vector<Primitive>& query_primitives, const Descriptors& query) const;
+  /// `checks` > 0 replaces MatchOptions::checks for these queries.
+  std::vector<DescriptorMatch> Match(const std::vector<Primitive>& query_primitives, const Descriptors& query,
+                                     int checks = 0) const;
 
  private:
   struct Index;

@@ -447,5 +447,47 @@ TEST(EcvMatching, MatchingInPartsGivesTheSameMatchesInMatchOrder) {
   }
 }
 
+// The recognizer ranks views with fewer checks per query than it matches with: a call's `checks` replaces the
+// options' for that call only, and as many checks as rows is an exact search.
+TEST(EcvMatching, ChecksOfOneCallReplaceTheOptionsForThatCall) {
+  const LoadedFrame scene_frame = LoadYcbvFrame(test::DataPath("ycbv_subset/Example-Scenes/0001/000001"));
+  const LoadedFrame query_frame = LoadYcbvFrame(test::DataPath("ycbv_subset/Example-Scenes/0001/000019"));
+  const std::vector<Primitive> scene = ExtractPrimitives(scene_frame.rgbd).primitives;
+  const std::vector<Primitive> query = ExtractPrimitives(query_frame.rgbd).primitives;
+  const Descriptors scene_descriptors = ComputeDescriptors(scene), query_descriptors = ComputeDescriptors(query);
+  ASSERT_GT(scene_descriptors.values.rows, 1000);
+  auto same = [](const std::vector<DescriptorMatch>& a, const std::vector<DescriptorMatch>& b) {
+    if (a.size() != b.size()) return false;
+    for (size_t i = 0; i < a.size(); ++i) {
+      if (std::tie(a[i].query, a[i].train, a[i].distance) != std::tie(b[i].query, b[i].train, b[i].distance)) {
+        return false;
+      }
+    }
+    return true;
+  };
+  MatchOptions options;  // the kd-forest, 128 checks
+  MatchOptions fewer = options;
+  fewer.checks = 32;
+  MatchOptions exact = options;
+  exact.exact_below = scene_descriptors.values.rows + 1;
+  const DescriptorMatcher matcher(scene, scene_descriptors, options);
+  const std::vector<DescriptorMatch> default_checks = matcher.Match(query, query_descriptors);
+  const std::vector<DescriptorMatch> few_checks = matcher.Match(query, query_descriptors, 32);
+  EXPECT_TRUE(same(few_checks, DescriptorMatcher(scene, scene_descriptors, fewer).Match(query, query_descriptors)));
+  EXPECT_FALSE(same(few_checks, default_checks));
+  EXPECT_TRUE(same(matcher.Match(query, query_descriptors), default_checks));  // the options again, after the call
+  EXPECT_TRUE(same(matcher.Match(query, query_descriptors, scene_descriptors.values.rows),
+                   DescriptorMatcher(scene, scene_descriptors, exact).Match(query, query_descriptors)));
+  // Fewer checks find the exact neighbour less often.
+  const std::vector<DescriptorMatch> exact_matches =
+      DescriptorMatcher(scene, scene_descriptors, exact).Match(query, query_descriptors);
+  auto exact_share = [&](const std::vector<DescriptorMatch>& matches) {
+    int found = 0;
+    for (size_t i = 0; i < matches.size(); ++i) found += matches[i].train == exact_matches[i].train ? 1 : 0;
+    return static_cast<double>(found) / static_cast<double>(matches.size());
+  };
+  EXPECT_LT(exact_share(few_checks), exact_share(default_checks));
+}
+
 }  // namespace
 }  // namespace ecv
