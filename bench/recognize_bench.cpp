@@ -7,8 +7,9 @@
 //   scripts/build_ycbv_library /tmp/ycbv.sqlite --views 40 --distance 0.9
 //   scripts/build_lmo_library /tmp/lmo.sqlite --views 40 --distance 1.0
 //   recognize_bench --db /tmp/ycbv.sqlite [--lmo-db /tmp/lmo.sqlite] [--peers] [--track] [--search-every N]
-//                   [--threads N] [--results bench/RESULTS.md] [--frames N]
+//                   [--threads N] [--bytes] [--results bench/RESULTS.md] [--frames N]
 // --threads N (N > 1) adds a run of ours with N worker threads: the same detections (checked), its own times.
+// --bytes adds a run of ours matching with ByteNeighbours (recognize --matcher bytes; needs AVX-512 VNNI).
 // --track adds a run with the previous frame's detections as priors; --search-every N (N > 1) one more where
 // only every N-th frame of a video searches the models that are not tracked (recognize --search-every).
 // --object-pixels also runs the peers on depth cut to the ground-truth objects' own pixels; --peers-only,
@@ -22,6 +23,7 @@
 #include <sstream>
 
 #include "bench_util.h"
+#include "core/byte_neighbours.h"
 #include "io/frame_io.h"
 #include "recognition_peers.h"
 #include "recognize/evaluation.h"
@@ -258,6 +260,7 @@ NamedFrame ObjectPixelsOnly(const NamedFrame& frame, const std::vector<PeerModel
 }
 
 const char* kTracking = "ECV + RANSAC + ICP, tracking";
+const char* kBytes = "ECV + RANSAC + ICP, --matcher bytes";
 const char* kPcl = "PCL FPFH + prerejective + ICP";
 const char* kPpf = "OpenCV PPF + ICP";
 
@@ -278,6 +281,7 @@ struct Methods {
   int search_every = 1;        ///< > 1: ours also tracking with a full search only every n-th frame
   bool peers = false;          ///< PCL and OpenCV PPF on the whole frames
   bool object_pixels = false;  ///< the peers also on the objects' pixels only
+  bool bytes = false;          ///< ours also with MatchIndex::kBytes (recognize --matcher bytes; AVX-512 VNNI only)
   int threads = 1;             ///< > 1: ours also with this many worker threads (the same detections, faster)
 };
 
@@ -304,6 +308,11 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
       runs.emplace_back(label, RunRecognizer(library, threaded, frames, models, "threads"));
       *notes << label << ": detections " << (SameDetections(runs.front().second, runs.back().second) ? "" : "NOT ")
              << "identical to one thread's. ";
+    }
+    if (methods.bytes) {
+      RecognizerOptions bytes = options;
+      bytes.match.index = MatchIndex::kBytes;
+      runs.emplace_back(kBytes, RunRecognizer(library, bytes, frames, models, "bytes"));
     }
     if (methods.track) {
       runs.emplace_back(kTracking, RunRecognizer(library, options, frames, models, "track", true));
@@ -396,6 +405,12 @@ int main(int argc, char** argv) {
         db.clear();
         break;
       }
+    } else if (std::strcmp(argv[i], "--bytes") == 0) {
+      if (!ByteNeighbours::CpuHasVnni()) {
+        std::cerr << "recognize_bench: --bytes needs AVX-512 VNNI, which this CPU lacks\n";
+        return 2;
+      }
+      methods.bytes = true;
     } else if (std::strcmp(argv[i], "--track") == 0) {
       methods.track = true;
     } else if (has_value && std::strcmp(argv[i], "--search-every") == 0) {
@@ -429,7 +444,7 @@ int main(int argc, char** argv) {
   if (db.empty()) {
     std::cerr
         << "usage: recognize_bench --db LIB.sqlite [--lmo-db LMO.sqlite] [--peers | --peers-only] [--object-pixels]\n"
-           "         [--track] [--search-every N] [--threads N]\n"
+           "         [--track] [--search-every N] [--threads N] [--bytes]\n"
            "         [--results FILE] [--frames N] [--frame-step S] [--ppf-sampling R] [--ppf-scene-distance R]\n"
            "         [--min-inlier-fraction F]\n"
            "  (build the libraries with scripts/build_ycbv_library LIB.sqlite --views 40 --distance 0.9 and\n"
@@ -447,6 +462,11 @@ int main(int argc, char** argv) {
              << RecallTable(runs);
     if (methods.ours)
       markdown << "\nTime per frame, whole library (ECV + RANSAC + ICP):\n\n" << TimingTable(runs.front().second);
+    if (methods.ours && methods.bytes) {
+      markdown << "\nThe same matching with ByteNeighbours (`recognize --matcher bytes`: every scene descriptor "
+                  "compared over 7-bit values, AVX-512 VNNI):\n\n"
+               << TimingTable(RunNamed(runs, kBytes));
+    }
     if (methods.ours && methods.track) {
       markdown << "\nThe same with tracking (each frame gets the previous frame's detections of its video as priors; "
                   "the first frame of each video has none):\n\n"

@@ -298,7 +298,7 @@ CommandAction SetupRecognizeCommand(CLI::App& command) {
   command
       .add_option("--matcher", args->matcher,
                   "kd-forest (FLANN's randomised kd-trees, approximate: the same matches on every CPU) or bytes\n"
-                  "(every scene descriptor compared over 7-bit values: nearer neighbours, 2.3x faster where the CPU\n"
+                  "(every scene descriptor compared over 7-bit values: nearer neighbours, 2x faster where the CPU\n"
                   "has AVX-512 VNNI, 10x slower where it has not)")
       ->check(CLI::IsMember({"kd-forest", "bytes"}))
       ->capture_default_str();

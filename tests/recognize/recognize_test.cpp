@@ -90,6 +90,29 @@ TEST_F(RecognizeEndToEnd, FindsTheObjectsOfTheDemoFrameWithinTenthOfTheirDiamete
   EXPECT_NE(eval.output.find("| 003_cracker_box | yes |"), std::string::npos) << eval.output;
 }
 
+// The speed options: exact matching over 7-bit descriptors (plain loop or VNNI, the same matches) and view ranking
+// with fewer checks still find the demo frame's three objects; an unknown matcher is named.
+TEST_F(RecognizeEndToEnd, TheBytesMatcherAndFewerRankingChecksFindTheDemoFramesObjects) {
+  const LoadedFrame frame = LoadYcbvFrame(Frame());
+  const std::vector<EvalModel> models = EvalModels(Library());
+  for (const std::string flags : {"--matcher bytes", "--ranking-checks 32"}) {
+    const std::string json = directory_->File("speed.json");
+    const test::CommandResult run =
+        test::RunCli("recognize --db " + library_ + " " + Frame() + " " + flags + " --out-json " + json);
+    ASSERT_EQ(run.exit_code, 0) << flags << "\n" << run.output;
+    const FrameEvaluation evaluation =
+        EvaluateFrame("0001/000001", DetectionsFromJson(ReadJsonFile(json), json), frame.ground_truth, models);
+    EXPECT_EQ(evaluation.false_positives, 0) << flags << "\n" << run.output;
+    for (const ObjectEvaluation& object : evaluation.objects) {
+      EXPECT_TRUE(object.correct) << flags << ": " << object.model << "\n" << run.output;
+    }
+    EXPECT_EQ(evaluation.objects.size(), 3U);
+  }
+  const test::CommandResult bad = test::RunCli("recognize --db " + library_ + " " + Frame() + " --matcher flann");
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.output.find("--matcher"), std::string::npos) << bad.output;
+}
+
 // View ranking alone (what ranking_bench studies): every view of every model, best first, and the views ranked
 // first for the cracker box hold right correspondences (its view picked first had 10 of 10 good in ranking_bench).
 TEST_F(RecognizeEndToEnd, RankViewsListsEveryViewBestFirstAndRanksARightViewFirstForTheCrackerBox) {
