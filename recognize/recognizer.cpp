@@ -561,14 +561,14 @@ class Recognizer::Impl {
   int RankingChecks() const { return options_.ranking_checks > 0 ? options_.ranking_checks : options_.match.checks; }
 
   // Gives `candidate` its correspondences, once: the nearest scene descriptor of each of its descriptors (paper:
-  // object to scene). The ranking has matched a subset of them; when it searched as matching does, only the
-  // others are searched here. The correspondences are put in the order in which matching all the rows at once
-  // gives them (MatchOrderLess), so that RANSAC draws the same samples.
+  // object to scene). The ranking has matched a subset of them; when it searched as matching does (or the search
+  // is exact, MatchIndex::kBytes), only the others are searched here. The correspondences are put in the order in which
+  // matching all the rows at once gives them (MatchOrderLess), so that RANSAC draws the same samples.
   void Match(size_t model, const Scene& scene, ViewCandidate* candidate) const {
     if (candidate->matched) return;
     const auto view = static_cast<size_t>(candidate->view);
     const ModelView& model_view = records_[model].views[view];
-    const bool reuse_ranking = RankingChecks() == options_.match.checks;
+    const bool reuse_ranking = RankingChecks() == options_.match.checks || options_.match.index == MatchIndex::kBytes;
     std::vector<Correspondence> found;
     if (reuse_ranking) {
       found = Correspondences(model_view, CopyRows(model_view.descriptors, RankingRows(model, view).rest), scene);
