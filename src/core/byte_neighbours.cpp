@@ -14,10 +14,9 @@
 namespace ecv {
 namespace {
 
-constexpr int kBlock = 16;             // rows per block: one 512-bit register of 32-bit sums
-constexpr int kGroupBytes = 4;         // bytes one VNNI lane multiplies and adds
-constexpr float kLevels = 127.0F;      // 7 bits: a quantised query fits VNNI's signed operand
-constexpr int32_t kPadding = 1 << 28;  // squared norm of a padding row: farther than any real row (96 x 127^2)
+constexpr int kLanes = 16;         // queries per VNNI sweep: one 512-bit register of 32-bit sums
+constexpr int kGroupBytes = 4;     // bytes one VNNI lane multiplies and adds
+constexpr float kLevels = 127.0F;  // 7 bits: a quantised row fits VNNI's signed operand
 
 std::atomic<bool> allow_vnni{true};
 
@@ -40,29 +39,11 @@ int32_t QuantiseRow(const float* values, int cols, uint8_t* bytes, int groups) {
   return norm;
 }
 
-// The dot products of `query` with the 16 rows of `block` (groups x 16 rows x 4 bytes): a plain loop.
-void BlockDotsPlain(const uint8_t* block, const uint8_t* query, int groups, int32_t* dots) {
-  std::fill(dots, dots + kBlock, 0);
-  for (int g = 0; g < groups; ++g) {
-    const uint8_t* q = query + g * kGroupBytes;
-    const uint8_t* rows = block + g * kBlock * kGroupBytes;
-    for (int lane = 0; lane < kBlock; ++lane) {
-      const uint8_t* r = rows + lane * kGroupBytes;
-      dots[lane] += r[0] * q[0] + r[1] * q[1] + r[2] * q[2] + r[3] * q[3];
-    }
-  }
-}
-
-// The same with one VNNI instruction per group.
-__attribute__((target("avx512f,avx512bw,avx512vnni"))) void BlockDotsVnni(const uint8_t* block, const uint8_t* query,
-                                                                          int groups, int32_t* dots) {
-  __m512i sum = _mm512_setzero_si512();
-  for (int g = 0; g < groups; ++g) {
-    int32_t q;
-    std::memcpy(&q, query + g * kGroupBytes, sizeof q);
-    sum = _mm512_dpbusd_epi32(sum, _mm512_loadu_si512(block + g * kBlock * kGroupBytes), _mm512_set1_epi32(q));
-  }
-  _mm512_storeu_si512(dots, sum);
+// The dot product of two quantised rows (groups x 4 bytes each): a plain loop.
+int32_t Dot(const uint8_t* a, const uint8_t* b, int bytes) {
+  int32_t sum = 0;
+  for (int i = 0; i < bytes; ++i) sum += static_cast<int32_t>(a[i]) * b[i];
+  return sum;
 }
 
 // The nearest row (k = 1) of each of `count` (at most 16) queries, the lowest row on a tie. The queries lie in the
@@ -75,12 +56,12 @@ __attribute__((target("avx512f,avx512bw,avx512vnni"))) void NearestVnni(const ui
                                                                         int groups, std::pair<int32_t, int>* nearest) {
   constexpr int kMaxGroups = 64;
   __m512i lanes[kMaxGroups];  // group g of the 16 queries
-  int32_t words[kBlock] = {};
+  int32_t words[kLanes] = {};
   for (int g = 0; g < groups; ++g) {
     for (int q = 0; q < count; ++q) std::memcpy(&words[q], queries + (q * groups + g) * kGroupBytes, kGroupBytes);
     lanes[g] = _mm512_loadu_si512(words);
   }
-  int32_t norm_words[kBlock] = {};
+  int32_t norm_words[kLanes] = {};
   std::copy(query_norms, query_norms + count, norm_words);
   const __m512i query_norm = _mm512_loadu_si512(norm_words);
   __m512i best = _mm512_set1_epi32(std::numeric_limits<int32_t>::max());
@@ -110,7 +91,7 @@ __attribute__((target("avx512f,avx512bw,avx512vnni"))) void NearestVnni(const ui
     best = _mm512_mask_mov_epi32(best, nearer, distance);
     best_row = _mm512_mask_mov_epi32(best_row, nearer, _mm512_set1_epi32(r));
   }
-  int32_t distances[kBlock], found[kBlock];
+  int32_t distances[kLanes], found[kLanes];
   _mm512_storeu_si512(distances, best);
   _mm512_storeu_si512(found, best_row);
   for (int q = 0; q < count; ++q) nearest[q] = {distances[q], found[q]};
@@ -133,19 +114,12 @@ ByteNeighbours::ByteNeighbours(const cv::Mat& rows) : rows_(rows.rows), cols_(ro
     ThrowInputError("byte neighbours", "rows", "a CV_32FC1 matrix");
   }
   groups_ = (cols_ + kGroupBytes - 1) / kGroupBytes;
-  const int block_count = (rows_ + kBlock - 1) / kBlock;
-  const size_t block_bytes = static_cast<size_t>(groups_) * kBlock * kGroupBytes;
-  blocks_.assign(static_cast<size_t>(block_count) * block_bytes, 0);
-  norms_.assign(static_cast<size_t>(block_count) * kBlock, kPadding);
-  std::vector<uint8_t> bytes(static_cast<size_t>(groups_) * kGroupBytes);
+  const size_t row_bytes = static_cast<size_t>(groups_) * kGroupBytes;
+  bytes_.resize(static_cast<size_t>(rows_) * row_bytes);
+  norms_.resize(static_cast<size_t>(rows_));
   for (int row = 0; row < rows_; ++row) {
-    norms_[static_cast<size_t>(row)] = QuantiseRow(rows.ptr<float>(row), cols_, bytes.data(), groups_);
-    plain_.insert(plain_.end(), bytes.begin(), bytes.end());
-    uint8_t* block = blocks_.data() + static_cast<size_t>(row / kBlock) * block_bytes;
-    const int lane = row % kBlock;
-    for (int g = 0; g < groups_; ++g) {
-      std::memcpy(block + (g * kBlock + lane) * kGroupBytes, bytes.data() + g * kGroupBytes, kGroupBytes);
-    }
+    norms_[static_cast<size_t>(row)] =
+        QuantiseRow(rows.ptr<float>(row), cols_, &bytes_[static_cast<size_t>(row) * row_bytes], groups_);
   }
 }
 
@@ -158,8 +132,6 @@ void ByteNeighbours::Search(const cv::Mat& queries, int k, cv::Mat* indices, cv:
   indices->create(queries.rows, k, CV_32SC1);
   squared_distances->create(queries.rows, k, CV_32FC1);
   const bool vnni = UseVnni();
-  const int block_count = (rows_ + kBlock - 1) / kBlock;
-  const size_t block_bytes = static_cast<size_t>(groups_) * kBlock * kGroupBytes;
   const size_t query_bytes = static_cast<size_t>(groups_) * kGroupBytes;
   const float unit = 1.0F / (kLevels * kLevels);
   auto write = [&](int q, int i, int32_t distance, int row) {
@@ -168,7 +140,7 @@ void ByteNeighbours::Search(const cv::Mat& queries, int k, cv::Mat* indices, cv:
         row >= 0 ? static_cast<float>(distance) * unit : std::numeric_limits<float>::infinity();
   };
   if (vnni && k == 1 && rows_ > 0) {  // the recognizer's case: four queries per sweep over the rows
-    constexpr int kQueries = kBlock;
+    constexpr int kQueries = kLanes;
     std::vector<uint8_t> quantised(kQueries * query_bytes);
     int32_t norms[kQueries];
     std::pair<int32_t, int> nearest[kQueries];
@@ -177,7 +149,7 @@ void ByteNeighbours::Search(const cv::Mat& queries, int k, cv::Mat* indices, cv:
       for (int i = 0; i < count; ++i) {
         norms[i] = QuantiseRow(queries.ptr<float>(first + i), cols_, &quantised[i * query_bytes], groups_);
       }
-      NearestVnni(plain_.data(), norms_.data(), rows_, quantised.data(), norms, count, groups_, nearest);
+      NearestVnni(bytes_.data(), norms_.data(), rows_, quantised.data(), norms, count, groups_, nearest);
       for (int i = 0; i < count; ++i) write(first + i, 0, nearest[i].first, nearest[i].second);
     }
     return;
@@ -185,32 +157,24 @@ void ByteNeighbours::Search(const cv::Mat& queries, int k, cv::Mat* indices, cv:
   std::vector<uint8_t> query(query_bytes);
   std::vector<int32_t> best_distance;
   std::vector<int> best_row;
-  int32_t dots[kBlock];
   for (int q = 0; q < queries.rows; ++q) {
     const int32_t query_norm = QuantiseRow(queries.ptr<float>(q), cols_, query.data(), groups_);
     best_distance.clear();
     best_row.clear();
-    for (int b = 0; b < block_count; ++b) {
-      const uint8_t* block = blocks_.data() + static_cast<size_t>(b) * block_bytes;
-      if (vnni) {
-        BlockDotsVnni(block, query.data(), groups_, dots);
-      } else {
-        BlockDotsPlain(block, query.data(), groups_, dots);
+    for (int row = 0; row < rows_; ++row) {
+      const int32_t distance =
+          norms_[static_cast<size_t>(row)] + query_norm -
+          2 * Dot(&bytes_[static_cast<size_t>(row) * query_bytes], query.data(), static_cast<int>(query_bytes));
+      const bool full = static_cast<int>(best_row.size()) == k;
+      if (full && distance >= best_distance.back()) continue;  // rows rise: a tie stays with the lower row
+      if (full) {
+        best_distance.pop_back();
+        best_row.pop_back();
       }
-      for (int lane = 0; lane < kBlock && b * kBlock + lane < rows_; ++lane) {
-        const int row = b * kBlock + lane;
-        const int32_t distance = norms_[static_cast<size_t>(row)] + query_norm - 2 * dots[lane];
-        const bool full = static_cast<int>(best_row.size()) == k;
-        if (full && distance >= best_distance.back()) continue;  // rows rise: a tie stays with the lower row
-        if (full) {
-          best_distance.pop_back();
-          best_row.pop_back();
-        }
-        size_t at = best_row.size();
-        while (at > 0 && distance < best_distance[at - 1]) --at;
-        best_distance.insert(best_distance.begin() + static_cast<std::ptrdiff_t>(at), distance);
-        best_row.insert(best_row.begin() + static_cast<std::ptrdiff_t>(at), row);
-      }
+      size_t at = best_row.size();
+      while (at > 0 && distance < best_distance[at - 1]) --at;
+      best_distance.insert(best_distance.begin() + static_cast<std::ptrdiff_t>(at), distance);
+      best_row.insert(best_row.begin() + static_cast<std::ptrdiff_t>(at), row);
     }
     for (int i = 0; i < k; ++i) {
       const bool found = i < static_cast<int>(best_row.size());

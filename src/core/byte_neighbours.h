@@ -8,10 +8,11 @@
 namespace ecv {
 
 /// Exact nearest neighbours (Euclidean) among rows of values in [0, 1] quantised to 7 bits (round(127 v), values
-/// outside clamped): every row is compared, in integer arithmetic, so the result does not depend on the CPU. The
-/// rows are kept in blocks of 16 interleaved by groups of 4 bytes, so that one AVX-512 VNNI instruction adds a
-/// group's products for 16 rows at once (the CPUs without it take a plain loop to the same sums). Made for the
-/// context descriptors, whose values are square roots of histogram shares. Thread-safe to search once built.
+/// outside clamped): every row is compared, in integer arithmetic, so the result does not depend on the CPU. For
+/// the nearest row alone (k = 1), on a CPU with AVX-512 VNNI, 16 queries lie in the lanes of one register per
+/// 4-byte group and each row's group is broadcast into one VNNI instruction, so that a row is read once for 16
+/// queries; otherwise a plain loop (about 50x slower) gives the same integers. Made for the context descriptors,
+/// whose values are square roots of histogram shares. Thread-safe to search once built.
 class ByteNeighbours {
  public:
   /// Indexes the rows of `rows` (CV_32FC1, one point per row).
@@ -26,16 +27,15 @@ class ByteNeighbours {
 
   /// False: Search takes the plain loop even where AVX-512 VNNI is available (tests compare the two).
   static void AllowVnni(bool allow);
-  /// True when this CPU has AVX-512 VNNI: without it Search is about 10x slower (bench/matching_bench).
+  /// True when this CPU has AVX-512 VNNI: without it Search takes the plain loop (bench/matching_bench).
   static bool CpuHasVnni();
 
  private:
   int rows_ = 0;
   int cols_ = 0;
-  int groups_ = 0;               // 4-byte groups per row: ceil(cols / 4)
-  std::vector<uint8_t> blocks_;  // per block of 16 rows: groups_ x 16 rows x 4 bytes
-  std::vector<uint8_t> plain_;   // the rows one after the other, groups_ x 4 bytes each
-  std::vector<int32_t> norms_;   // squared norm of each quantised row (padding rows: a huge value)
+  int groups_ = 0;              // 4-byte groups per row: ceil(cols / 4)
+  std::vector<uint8_t> bytes_;  // the quantised rows one after the other, groups_ x 4 bytes each (zero-padded)
+  std::vector<int32_t> norms_;  // squared norm of each quantised row
 };
 
 }  // namespace ecv
