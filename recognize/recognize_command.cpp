@@ -115,7 +115,8 @@ int RunRecognize(const RecognizeArgs& args) {
   if (args.matcher == "bytes") {
     options.match.index = MatchIndex::kBytes;
     if (!ByteNeighbours::CpuHasVnni()) {
-      std::cerr << "recognize: warning: --matcher bytes without AVX-512 VNNI on this CPU: matching about 20x slower than the kd-forest\n";
+      std::cerr << "recognize: warning: --matcher bytes without AVX-512 VNNI on this CPU: matching about 20x slower "
+                   "than the kd-forest\n";
     }
   }
   options.Check();
