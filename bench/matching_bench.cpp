@@ -59,15 +59,15 @@ std::vector<Matcher> Matchers() {
   for (const int checks : {32, 64, 128}) add(MatchIndex::kFlann, 4, 1, checks);
   for (const int checks : {32, 64, 128}) add(MatchIndex::kKdForest, 2, 8, checks);
   for (const int checks : {64, 128}) add(MatchIndex::kKdForest, 4, 8, checks);
+  // Both of ByteNeighbours' kernels where the CPU has VNNI; the plain loop alone where it has not.
   for (const bool vnni : {true, false}) {
+    if (vnni && !ByteNeighbours::CpuHasVnni()) continue;
     Matcher matcher;
     matcher.options = RecognizerOptions::DefaultMatch();
     matcher.options.index = MatchIndex::kBytes;
     matcher.vnni = vnni;
-    const bool has_vnni = __builtin_cpu_supports("avx512vnni");
-    matcher.name = std::string("ByteNeighbours (every row, 7-bit values), ") +
-                   (vnni && has_vnni ? "AVX-512 VNNI" : "plain loop") + (vnni || has_vnni ? "" : " (no VNNI here)");
-    if (vnni || has_vnni) matchers.push_back(matcher);
+    matcher.name = std::string("ByteNeighbours (every row, 7-bit values), ") + (vnni ? "AVX-512 VNNI" : "plain loop");
+    matchers.push_back(matcher);
   }
   return matchers;
 }
@@ -145,19 +145,16 @@ void Measure(const Matcher& matcher, const std::vector<Primitive>& scene, const 
   tally->search_ms += MillisecondsSince(start);
   ByteNeighbours::AllowVnni(true);
   if (matches.size() != exact.size()) throw std::logic_error(matcher.name + ": not one match per query");
-  // The float distance to the row found (ByteNeighbours reports the quantised one).
+  // The float distance to the row found (ByteNeighbours reports the quantised one). A query's row is its
+  // primitive's index (RankingQueries); a scene primitive's row is looked up.
   std::vector<int> scene_row(scene.size(), -1);
   for (size_t row = 0; row < scene_descriptors.primitive.size(); ++row) {
     scene_row[static_cast<size_t>(scene_descriptors.primitive[row])] = static_cast<int>(row);
   }
-  std::vector<int> query_row(query.size(), -1);
-  for (size_t row = 0; row < queries.primitive.size(); ++row) {
-    query_row[static_cast<size_t>(queries.primitive[row])] = static_cast<int>(row);
-  }
   for (size_t i = 0; i < matches.size(); ++i) {
     ++tally->queries;
     const float distance = static_cast<float>(
-        cv::norm(queries.values.row(query_row[static_cast<size_t>(matches[i].query)]),
+        cv::norm(queries.values.row(matches[i].query),
                  scene_descriptors.values.row(scene_row[static_cast<size_t>(matches[i].train)]), cv::NORM_L2));
     // Float sums in another order: equal within a relative 1e-5.
     tally->exact_found += distance <= exact[i] * (1.0F + 1e-5F) ? 1 : 0;

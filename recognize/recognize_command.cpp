@@ -252,7 +252,7 @@ CommandAction SetupRecognizeCommand(CLI::App& command) {
   command
       .add_option("--ranking-checks", options.ranking_checks,
                   "Descriptors compared per query when ranking the library's views (0: as many as matching, 128);\n"
-                  "32 ranks in half the time, less well (README: Speed)")
+                  "32 ranks in half the time, less well (bench/RESULTS.md, session 29)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   command.add_option("--min-score", options.min_score, "Detections below this score are dropped")

@@ -16,6 +16,7 @@ namespace {
 
 constexpr int kLanes = 16;         // queries per VNNI sweep: one 512-bit register of 32-bit sums
 constexpr int kGroupBytes = 4;     // bytes one VNNI lane multiplies and adds
+constexpr int kMaxGroups = 64;     // the VNNI kernel keeps the queries' groups of at most 256 values
 constexpr float kLevels = 127.0F;  // 7 bits: a quantised row fits VNNI's signed operand
 
 std::atomic<bool> allow_vnni{true};
@@ -54,7 +55,6 @@ __attribute__((target("avx512f,avx512bw,avx512vnni"))) void NearestVnni(const ui
                                                                         int row_count, const uint8_t* queries,
                                                                         const int32_t* query_norms, int count,
                                                                         int groups, std::pair<int32_t, int>* nearest) {
-  constexpr int kMaxGroups = 64;
   __m512i lanes[kMaxGroups];  // group g of the 16 queries
   int32_t words[kLanes] = {};
   for (int g = 0; g < groups; ++g) {
@@ -128,7 +128,6 @@ void ByteNeighbours::Search(const cv::Mat& queries, int k, cv::Mat* indices, cv:
   if (queries.type() != CV_32FC1 || (queries.rows > 0 && rows_ > 0 && queries.cols != cols_)) {
     ThrowInputError("byte neighbours search", "queries", "CV_32FC1 rows of " + std::to_string(cols_) + " columns");
   }
-  if (groups_ > 64) ThrowInputError("byte neighbours search", "columns", "at most 256");
   indices->create(queries.rows, k, CV_32SC1);
   squared_distances->create(queries.rows, k, CV_32FC1);
   const bool vnni = UseVnni();
@@ -139,13 +138,12 @@ void ByteNeighbours::Search(const cv::Mat& queries, int k, cv::Mat* indices, cv:
     squared_distances->at<float>(q, i) =
         row >= 0 ? static_cast<float>(distance) * unit : std::numeric_limits<float>::infinity();
   };
-  if (vnni && k == 1 && rows_ > 0) {  // the recognizer's case: four queries per sweep over the rows
-    constexpr int kQueries = kLanes;
-    std::vector<uint8_t> quantised(kQueries * query_bytes);
-    int32_t norms[kQueries];
-    std::pair<int32_t, int> nearest[kQueries];
-    for (int first = 0; first < queries.rows; first += kQueries) {
-      const int count = std::min(kQueries, queries.rows - first);
+  if (vnni && k == 1 && rows_ > 0 && groups_ <= kMaxGroups) {  // the recognizer's case: 16 queries per sweep
+    std::vector<uint8_t> quantised(kLanes * query_bytes);
+    int32_t norms[kLanes];
+    std::pair<int32_t, int> nearest[kLanes];
+    for (int first = 0; first < queries.rows; first += kLanes) {
+      const int count = std::min(kLanes, queries.rows - first);
       for (int i = 0; i < count; ++i) {
         norms[i] = QuantiseRow(queries.ptr<float>(first + i), cols_, &quantised[i * query_bytes], groups_);
       }

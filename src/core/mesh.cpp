@@ -5,9 +5,9 @@
 #include <cmath>
 #include <cstdint>
 #include <numeric>
+#include <utility>
 
 #include <opencv2/imgproc.hpp>
-#include <utility>
 
 namespace ecv {
 

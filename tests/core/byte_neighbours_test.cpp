@@ -105,6 +105,11 @@ TEST_P(ByteNeighboursTest, TiesGoToTheLowerRow) {
   EXPECT_EQ(indices.at<int>(0, 1), 12) << Kernel();
   EXPECT_EQ(indices.at<int>(0, 2), 30) << Kernel();
   EXPECT_EQ(squared.at<float>(0, 0), 0.0F);
+  // The nearest alone (the VNNI kernel's case, in lane order and across sweeps of 16 queries).
+  cv::Mat queries;
+  for (int i = 0; i < 20; ++i) queries.push_back(rows.row(30));
+  ByteNeighbours(rows).Search(queries, 1, &indices, &squared);
+  for (int q = 0; q < queries.rows; ++q) EXPECT_EQ(indices.at<int>(q, 0), 7) << Kernel() << ", query " << q;
 }
 
 INSTANTIATE_TEST_SUITE_P(Kernels, ByteNeighboursTest, ::testing::Bool(),
