@@ -60,6 +60,7 @@ void PeerOptions::Check() const {
   positive(pcl_iterations, "pcl_iterations", "a number of iterations > 0");
   positive(pcl_correspondence_randomness, "pcl_correspondence_randomness", "a number of neighbours > 0");
   positive(icp_iterations, "icp_iterations", "a number of iterations > 0");
+  positive(open3d_iterations, "open3d_iterations", "a number of iterations > 0");
   positive(ppf_normal_neighbours, "ppf_normal_neighbours", "a number of neighbours > 0");
   positive(inlier_distance_m, "inlier_distance_m", "a distance > 0 m");
   const auto fraction = [](double value, const char* field) {
@@ -72,6 +73,7 @@ void PeerOptions::Check() const {
   fraction(ppf_scene_sample_step, "ppf_scene_sample_step");
   fraction(ppf_scene_distance, "ppf_scene_distance");
   fraction(min_inlier_fraction, "min_inlier_fraction");
+  fraction(open3d_confidence, "open3d_confidence");
 }
 
 PeerModel SamplePeerModel(const ModelRecord& record, double spacing_m, unsigned seed) {

@@ -1,8 +1,9 @@
 #pragma once
 
-// Whole-frame recognition peers for recognize_bench (issue 9): PCL's FPFH + SampleConsensusPrerejective + ICP and
-// OpenCV's PPF detector (ppf_match_3d) + its ICP. They return detections like ours, so EvaluateFrame scores them
-// alike. PCL and OpenCV's surface_matching stay in recognition_peer_pcl.cpp and recognition_peer_ppf.cpp.
+// Whole-frame recognition peers for recognize_bench (issue 9): PCL's FPFH + SampleConsensusPrerejective + ICP,
+// OpenCV's PPF detector (ppf_match_3d) + its ICP, and Open3D's FPFH + RANSAC + ICP recipe (through Python). They
+// return detections like ours, so EvaluateFrame scores them alike. PCL and OpenCV's surface_matching stay in
+// recognition_peer_pcl.cpp and recognition_peer_ppf.cpp; recognition_peer_open3d.cpp runs recognition_open3d.py.
 
 #include <memory>
 #include <string>
@@ -39,7 +40,9 @@ struct PeerOptions {
   int pcl_iterations = 50000;             ///< SampleConsensusPrerejective iterations per model
   int pcl_correspondence_randomness = 5;  ///< nearest FPFH neighbours a sample picks from
   double pcl_similarity = 0.9;            ///< edge-length similarity of the prerejection (1 - t_poly)
-  int icp_iterations = 30;                ///< PCL ICP iterations; OpenCV ICP iterations
+  int icp_iterations = 30;                ///< PCL ICP iterations; OpenCV ICP iterations; Open3D ICP iterations
+  int open3d_iterations = 100000;         ///< Open3D feature RANSAC: iterations at most (its recipe's)
+  double open3d_confidence = 0.999;       ///< Open3D feature RANSAC: early exit (its recipe's)
   /// PPF3DDetector model sampling step, relative to the model's box (the usual 0.05 trains for minutes: OpenCV's
   /// hash table walks the chain of equal keys on every insert).
   double ppf_relative_sampling = 0.08;
@@ -77,6 +80,14 @@ std::unique_ptr<RecognitionPeer> MakePclPeer(const std::vector<PeerModel>& model
 
 /// OpenCV: PPF3DDetector trained per model (when made), matched on the scene, the best pose refined by its ICP.
 std::unique_ptr<RecognitionPeer> MakePpfPeer(const std::vector<PeerModel>& models, const PeerOptions& options);
+
+/// Open3D's global registration recipe (FPFH, registration_ransac_based_on_feature_matching, point-to-plane ICP)
+/// through `script` (bench/recognition_open3d.py) under `python`, one process per frame, one OpenMP thread. The
+/// frame's time is the script's: the scene's cloud and features and every model's RANSAC and ICP (not the process
+/// start nor the models' features). nullptr, with the reason in `*problem`, when Open3D cannot be imported.
+std::unique_ptr<RecognitionPeer> MakeOpen3dPeer(const std::vector<PeerModel>& models, const PeerOptions& options,
+                                                const std::string& python, const std::string& script,
+                                                std::string* problem);
 
 // Shared by both peers (recognition_peers.cpp).
 

@@ -1,13 +1,14 @@
 // Recognition on real data: every YCB-Video frame under ../shared/data through the recognizer with a library
 // of the textured YCB meshes, scored against the ground truth (recall at ADD < 0.1 d, false positives), with
 // and without ICP, and the time per frame split by stage. With --peers, the same frames through PCL (FPFH +
-// SampleConsensusPrerejective + ICP) and OpenCV's PPF detector (+ ICP) in the same run; with --lmo-db, the
-// Linemod-Occluded frame (8 vertex-coloured models) as its own table.
+// SampleConsensusPrerejective + ICP), OpenCV's PPF detector (+ ICP) and Open3D's FPFH + RANSAC + ICP recipe
+// (bench/recognition_open3d.py under --python EXE, default /usr/bin/python3; skipped, saying so, without Open3D)
+// in the same run; with --lmo-db, the Linemod-Occluded frame (8 vertex-coloured models) as its own table.
 //
 //   scripts/build_ycbv_library /tmp/ycbv.sqlite --views 40 --distance 0.9
 //   scripts/build_lmo_library /tmp/lmo.sqlite --views 40 --distance 1.0
 //   recognize_bench --db /tmp/ycbv.sqlite [--lmo-db /tmp/lmo.sqlite] [--peers] [--track] [--search-every N]
-//                   [--threads N] [--bytes] [--results bench/RESULTS.md] [--frames N]
+//                   [--threads N] [--bytes] [--python EXE] [--results bench/RESULTS.md] [--frames N]
 // --threads N (N > 1) adds a run of ours with N worker threads: the same detections (checked), its own times.
 // --bytes adds a run of ours matching with ByteNeighbours (recognize --matcher bytes; needs AVX-512 VNNI).
 // --track adds a run with the previous frame's detections as priors; --search-every N (N > 1) one more where
@@ -263,6 +264,7 @@ const char* kTracking = "ECV + RANSAC + ICP, tracking";
 const char* kBytes = "ECV + RANSAC + ICP, --matcher bytes";
 const char* kPcl = "PCL FPFH + prerejective + ICP";
 const char* kPpf = "OpenCV PPF + ICP";
+const char* kOpen3d = "Open3D FPFH + RANSAC + ICP";
 
 // The label of tracking with a full search every `n`-th frame.
 std::string TrackingEvery(int n) {
@@ -276,13 +278,14 @@ const Run& RunNamed(const Runs& runs, const std::string& name) {
 
 // Which methods RunAll runs.
 struct Methods {
-  bool ours = true;            ///< ECV with and without ICP
-  bool track = false;          ///< ours also with the previous frame's detections as priors
-  int search_every = 1;        ///< > 1: ours also tracking with a full search only every n-th frame
-  bool peers = false;          ///< PCL and OpenCV PPF on the whole frames
-  bool object_pixels = false;  ///< the peers also on the objects' pixels only
-  bool bytes = false;          ///< ours also with MatchIndex::kBytes (recognize --matcher bytes; AVX-512 VNNI only)
-  int threads = 1;             ///< > 1: ours also with this many worker threads (the same detections, faster)
+  bool ours = true;                         ///< ECV with and without ICP
+  bool track = false;                       ///< ours also with the previous frame's detections as priors
+  int search_every = 1;                     ///< > 1: ours also tracking with a full search only every n-th frame
+  bool peers = false;                       ///< PCL and OpenCV PPF on the whole frames
+  bool object_pixels = false;               ///< the peers also on the objects' pixels only
+  std::string python = "/usr/bin/python3";  ///< the interpreter that runs the Open3D peer
+  bool bytes = false;  ///< ours also with MatchIndex::kBytes (recognize --matcher bytes; AVX-512 VNNI only)
+  int threads = 1;     ///< > 1: ours also with this many worker threads (the same detections, faster)
 };
 
 // The `methods` on `frames` with the library at `db`.
@@ -336,11 +339,25 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
   const std::unique_ptr<RecognitionPeer> ppf = MakePpfPeer(peer_models, peer_options);
   const double ppf_setup_ms = MillisecondsSince(start);
   runs.emplace_back(kPpf, RunPeer(*ppf, frames, models, "ppf"));
+  std::string open3d_problem;
+  const std::unique_ptr<RecognitionPeer> open3d =
+      MakeOpen3dPeer(peer_models, peer_options, methods.python,
+                     std::string(ECV_SOURCE_DIR) + "/bench/recognition_open3d.py", &open3d_problem);
+  if (open3d) {
+    runs.emplace_back(kOpen3d, RunPeer(*open3d, frames, models, "open3d"));
+  } else {
+    std::cerr << "recognize_bench: " << open3d_problem << '\n';
+    *notes << open3d_problem << ". ";
+  }
   if (methods.object_pixels) {
     std::vector<NamedFrame> masked;
     for (const NamedFrame& frame : frames) masked.push_back(ObjectPixelsOnly(frame, peer_models));
     runs.emplace_back(std::string(kPcl) + ", objects' pixels only", RunPeer(*pcl, masked, models, "pcl objects"));
     runs.emplace_back(std::string(kPpf) + ", objects' pixels only", RunPeer(*ppf, masked, models, "ppf objects"));
+    if (open3d) {
+      runs.emplace_back(std::string(kOpen3d) + ", objects' pixels only",
+                        RunPeer(*open3d, masked, models, "open3d objects"));
+    }
   }
   const Run& pcl_run = RunNamed(runs, kPcl);
   const Run& ppf_run = RunNamed(runs, kPpf);
@@ -348,7 +365,9 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
          << " ms for PCL, PPF training " << Fixed(ppf_setup_ms, 0) << " ms for OpenCV, not in the times per frame; "
          << "scene cloud " << Fixed(Median(pcl_run.stage_ms.at("scene points")), 0)
          << " points (median), its normals and features " << Fixed(Median(pcl_run.stage_ms.at("scene")), 0)
-         << " ms (PCL), " << Fixed(Median(ppf_run.stage_ms.at("scene")), 0) << " ms (OpenCV) per frame. ";
+         << " ms (PCL), " << Fixed(Median(ppf_run.stage_ms.at("scene")), 0) << " ms (OpenCV)";
+  if (open3d) *notes << ", " << Fixed(Median(RunNamed(runs, kOpen3d).stage_ms.at("scene")), 0) << " ms (Open3D)";
+  *notes << " per frame. ";
   return runs;
 }
 
@@ -372,8 +391,18 @@ std::string PeerSettings(const PeerOptions& o) {
       << " neighbours, turned to the camera); the most voted pose, its rotation made rigid (OpenCV 4.6 returns it "
          "scaled: the pose cluster's quaternions are averaged without normalising), refined with ppf_match_3d::ICP ("
       << o.icp_iterations
-      << " iterations) on the scene points within one model diameter, kept unless it lowers the inlier share. Both "
-         "peers report a model when, after ICP, at least "
+      << " iterations) on the scene points within one model diameter, kept unless it lowers the inlier share. "
+         "Open3D 0.16 (bench/recognition_open3d.py, one OpenMP thread, one process per frame whose start and model "
+         "features are not timed): the depth image to a cloud, the same voxel grid, normals (radius "
+      << Fixed(o.normal_radius_m * 1000, 0)
+      << " mm, at most 30 neighbours; the scene's turned to the camera, the model's to agree with the mesh's), FPFH "
+         "(radius "
+      << Fixed(o.fpfh_radius_m * 1000, 0)
+      << " mm, at most 100 neighbours), registration_ransac_based_on_feature_matching (at most " << o.open3d_iterations
+      << " iterations, confidence " << Fixed(o.open3d_confidence, 3) << ", 3 points, edge-length checker "
+      << Fixed(o.pcl_similarity, 2) << ", distance checker and inlier distance " << Fixed(o.inlier_distance_m * 1000, 0)
+      << " mm, seed " << o.seed << "), then point-to-plane ICP (" << o.icp_iterations << " iterations, "
+      << Fixed(o.inlier_distance_m * 1000, 0) << " mm). All peers report a model when, after ICP, at least "
       << Fixed(100 * o.min_inlier_fraction, 0) << " % of its voxelised points lie within "
       << Fixed(o.inlier_distance_m * 1000, 0)
       << " mm of a scene point (score = that share); at most one detection per model.\n";
@@ -428,6 +457,8 @@ int main(int argc, char** argv) {
       peer_options.ppf_scene_distance = std::atof(argv[++i]);
     } else if (has_value && std::strcmp(argv[i], "--min-inlier-fraction") == 0) {
       peer_options.min_inlier_fraction = std::atof(argv[++i]);
+    } else if (has_value && std::strcmp(argv[i], "--python") == 0) {
+      methods.python = argv[++i];
     } else if (has_value && std::strcmp(argv[i], "--db") == 0) {
       db = argv[++i];
     } else if (has_value && std::strcmp(argv[i], "--lmo-db") == 0) {
@@ -444,7 +475,7 @@ int main(int argc, char** argv) {
   if (db.empty()) {
     std::cerr
         << "usage: recognize_bench --db LIB.sqlite [--lmo-db LMO.sqlite] [--peers | --peers-only] [--object-pixels]\n"
-           "         [--track] [--search-every N] [--threads N] [--bytes]\n"
+           "         [--track] [--search-every N] [--threads N] [--bytes] [--python EXE]\n"
            "         [--results FILE] [--frames N] [--frame-step S] [--ppf-sampling R] [--ppf-scene-distance R]\n"
            "         [--min-inlier-fraction F]\n"
            "  (build the libraries with scripts/build_ycbv_library LIB.sqlite --views 40 --distance 0.9 and\n"
