@@ -144,6 +144,14 @@ int RunRecognize(const RecognizeArgs& args) {
   std::cerr << "recognize: meshes loaded for verification (" << stored << " stored in the library, "
             << library.models().size() - static_cast<size_t>(stored) << " from mesh files; " << MillisecondsSince(setup)
             << " ms)\n";
+  std::cerr << "recognize: descriptors matched by ";
+  if (options.match.index == MatchIndex::kBytes) {
+    std::cerr << "bytes (" << (ByteNeighbours::CpuHasVnni() ? "AVX-512 VNNI" : "plain loop") << ", exact)\n";
+  } else {
+    const int ranking_checks = options.ranking_checks > 0 ? options.ranking_checks : options.match.checks;
+    std::cerr << "kd-forest (" << options.match.trees << " trees, " << options.match.checks << " checks; view ranking "
+              << ranking_checks << ")\n";
+  }
 
   if (single) {
     const LoadedFrame& loaded = *single;

@@ -95,11 +95,16 @@ TEST_F(RecognizeEndToEnd, FindsTheObjectsOfTheDemoFrameWithinTenthOfTheirDiamete
 TEST_F(RecognizeEndToEnd, TheBytesMatcherAndFewerRankingChecksFindTheDemoFramesObjects) {
   const LoadedFrame frame = LoadYcbvFrame(Frame());
   const std::vector<EvalModel> models = EvalModels(Library());
-  for (const std::string flags : {"--matcher bytes", "--ranking-checks 32"}) {
+  // Each with the line that says how the descriptors were matched, so that an ignored flag shows.
+  const std::vector<std::pair<std::string, std::string>> runs = {
+      {"--matcher bytes", "descriptors matched by bytes ("},
+      {"--ranking-checks 32", "descriptors matched by kd-forest (4 trees, 128 checks; view ranking 32)"}};
+  for (const auto& [flags, says] : runs) {
     const std::string json = directory_->File("speed.json");
     const test::CommandResult run =
         test::RunCli("recognize --db " + library_ + " " + Frame() + " " + flags + " --out-json " + json);
     ASSERT_EQ(run.exit_code, 0) << flags << "\n" << run.output;
+    EXPECT_NE(run.output.find(says), std::string::npos) << flags << "\n" << run.output;
     const FrameEvaluation evaluation =
         EvaluateFrame("0001/000001", DetectionsFromJson(ReadJsonFile(json), json), frame.ground_truth, models);
     EXPECT_EQ(evaluation.false_positives, 0) << flags << "\n" << run.output;
