@@ -1,9 +1,11 @@
 #include "bench_util.h"
 
 #include <sched.h>
+#include <sys/wait.h>
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -85,6 +87,17 @@ void Report(const std::string& results_path, const std::string& title, const std
   std::ofstream results(results_path, std::ios::app);
   results << section;
   if (!results) std::cerr << "could not append to " << results_path << '\n';
+}
+
+std::string ShellQuoted(const std::string& text) {
+  std::string quoted = "'";
+  for (const char c : text) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return quoted + "'";
+}
+
+int RunShellCommand(const std::string& command) {
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
 }  // namespace ecv::bench

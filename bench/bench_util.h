@@ -36,6 +36,12 @@ std::vector<std::string> YcbvFramePrefixes(const std::string& data_dir);
 /// depth, see lmo_subset/SOURCE.md).
 LoadedFrame LmoFrame(const std::string& data_dir);
 
+/// `text` quoted for the shell (single quotes; a single quote inside is closed, escaped and reopened).
+std::string ShellQuoted(const std::string& text);
+
+/// Runs `command` with the shell; its exit code, or -1 when it did not exit normally.
+int RunShellCommand(const std::string& command);
+
 /// Prints `markdown` and appends it to `results_path` under a heading with `title`, the date, the machine
 /// and the command.
 void Report(const std::string& results_path, const std::string& title, const std::string& command,

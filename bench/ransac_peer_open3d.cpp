@@ -2,9 +2,6 @@
 
 #include "ransac_peer_open3d.h"
 
-#include <sys/wait.h>
-
-#include <cstdlib>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -15,10 +12,6 @@
 
 namespace ecv::bench {
 namespace {
-
-std::string Quoted(const std::string& text) {
-  return "'" + text + "'";
-}
 
 PeerPose ParseRun(const std::string& line, const std::string& source) {
   std::istringstream fields(line);
@@ -59,14 +52,13 @@ std::vector<PeerPose> RunOpen3dRansac(const std::filesystem::path& directory, co
                                       std::string* problem) {
   const std::filesystem::path output = directory / "open3d_runs.txt";
   std::filesystem::remove(output);
-  const std::string command = "OMP_NUM_THREADS=" + std::to_string(options.threads) + " " + Quoted(options.python) +
-                              " " + Quoted(options.script) + " " + Quoted(directory.string()) + " " +
-                              Quoted(output.string()) + " --runs " + std::to_string(options.runs) + " --iterations " +
-                              std::to_string(options.max_iterations) + " --confidence " + Fixed(options.confidence, 6) +
-                              " --distance " + Fixed(options.max_correspondence_distance, 6) + " --similarity " +
-                              Fixed(options.similarity_threshold, 6);
-  const int status = std::system(command.c_str());
-  const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  const std::string command =
+      "OMP_NUM_THREADS=" + std::to_string(options.threads) + " " + ShellQuoted(options.python) + " " +
+      ShellQuoted(options.script) + " " + ShellQuoted(directory.string()) + " " + ShellQuoted(output.string()) +
+      " --runs " + std::to_string(options.runs) + " --iterations " + std::to_string(options.max_iterations) +
+      " --confidence " + Fixed(options.confidence, 6) + " --distance " + Fixed(options.max_correspondence_distance, 6) +
+      " --similarity " + Fixed(options.similarity_threshold, 6);
+  const int code = RunShellCommand(command);
   if (code != 0) {
     *problem = code == 3 ? "Open3D is not installed for " + options.python +
                                " (install: apt-get install -y python3-open3d); Open3D skipped"

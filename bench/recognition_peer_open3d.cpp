@@ -1,11 +1,9 @@
 // The Open3D recognition peer: its global registration recipe (FPFH, feature RANSAC, ICP) through
 // bench/recognition_open3d.py, one process per frame; input and output through files in a scratch folder.
 
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -17,16 +15,6 @@
 
 namespace ecv::bench {
 namespace {
-
-std::string Quoted(const std::string& text) {
-  return "'" + text + "'";
-}
-
-// Exit code of `command` run by the shell; -1 when it did not exit normally.
-int RunCommand(const std::string& command) {
-  const int status = std::system(command.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
 
 void WriteFloats(const std::filesystem::path& path, const float* values, size_t count) {
   std::ofstream file(path, std::ios::binary);
@@ -78,13 +66,13 @@ class Open3dPeer : public RecognitionPeer {
     std::filesystem::remove(output);
     const PeerOptions& o = options_;
     const std::string command =
-        "OMP_NUM_THREADS=1 " + Quoted(python_) + " " + Quoted(script_) + " " + Quoted(directory_.string()) + " " +
-        Quoted(output.string()) + " --voxel " + Fixed(o.voxel_m, 6) + " --normal-radius " +
-        Fixed(o.normal_radius_m, 6) + " --fpfh-radius " + Fixed(o.fpfh_radius_m, 6) + " --iterations " +
-        std::to_string(o.open3d_iterations) + " --confidence " + Fixed(o.open3d_confidence, 6) + " --distance " +
-        Fixed(o.inlier_distance_m, 6) + " --similarity " + Fixed(o.pcl_similarity, 6) + " --icp-iterations " +
-        std::to_string(o.icp_iterations) + " --seed " + std::to_string(o.seed);
-    const int code = RunCommand(command);
+        "OMP_NUM_THREADS=1 " + ShellQuoted(python_) + " " + ShellQuoted(script_) + " " +
+        ShellQuoted(directory_.string()) + " " + ShellQuoted(output.string()) + " --voxel " + Fixed(o.voxel_m, 6) +
+        " --normal-radius " + Fixed(o.normal_radius_m, 6) + " --fpfh-radius " + Fixed(o.fpfh_radius_m, 6) +
+        " --iterations " + std::to_string(o.open3d_iterations) + " --confidence " + Fixed(o.open3d_confidence, 6) +
+        " --distance " + Fixed(o.inlier_distance_m, 6) + " --similarity " + Fixed(o.pcl_similarity, 6) +
+        " --icp-iterations " + std::to_string(o.icp_iterations) + " --seed " + std::to_string(o.seed);
+    const int code = RunShellCommand(command);
     if (code != 0) throw std::runtime_error(script_ + " failed (exit code " + std::to_string(code) + ")");
 
     PeerResult result;
@@ -131,7 +119,7 @@ class Open3dPeer : public RecognitionPeer {
 std::unique_ptr<RecognitionPeer> MakeOpen3dPeer(const std::vector<PeerModel>& models, const PeerOptions& options,
                                                 const std::string& python, const std::string& script,
                                                 std::string* problem) {
-  if (RunCommand(Quoted(python) + " -c 'import open3d' > /dev/null 2>&1") != 0) {
+  if (RunShellCommand(ShellQuoted(python) + " -c 'import open3d' > /dev/null 2>&1") != 0) {
     *problem = "Open3D cannot be imported by " + python + " (install: apt-get install -y python3-open3d); skipped";
     return nullptr;
   }
