@@ -8,11 +8,12 @@
 //   scripts/build_ycbv_library /tmp/ycbv.sqlite --views 40 --distance 0.9
 //   scripts/build_lmo_library /tmp/lmo.sqlite --views 40 --distance 1.0
 //   recognize_bench --db /tmp/ycbv.sqlite [--lmo-db /tmp/lmo.sqlite] [--peers] [--track] [--search-every N]
-//                   [--threads N] [--bytes] [--python EXE] [--results bench/RESULTS.md] [--frames N]
+//                   [--threads N] [--bytes] [--python EXE] [--figure F.jpg] [--results bench/RESULTS.md] [--frames N]
 // --threads N (N > 1) adds a run of ours with N worker threads: the same detections (checked), its own times.
 // --bytes adds a run of ours matching with ByteNeighbours (recognize --matcher bytes; needs AVX-512 VNNI).
 // --track adds a run with the previous frame's detections as priors; --search-every N (N > 1) one more where
 // only every N-th frame of a video searches the models that are not tracked (recognize --search-every).
+// --figure F.jpg draws the detections of ours and each peer in frame 0001/000001 (the demo frame) side by side.
 // --object-pixels also runs the peers on depth cut to the ground-truth objects' own pixels; --peers-only,
 // --frame-step, --ppf-sampling, --ppf-scene-distance and --min-inlier-fraction are for tuning the peers.
 
@@ -22,6 +23,9 @@
 #include <iostream>
 #include <map>
 #include <sstream>
+#include <stdexcept>
+
+#include <opencv2/imgproc.hpp>
 
 #include "bench_util.h"
 #include "core/byte_neighbours.h"
@@ -59,6 +63,7 @@ std::vector<NamedFrame> LmoFrames(const std::string& data) {
 
 struct Run {
   std::vector<FrameEvaluation> frames;
+  std::vector<std::vector<Detection>> detections;       // per frame
   std::map<std::string, std::vector<double>> stage_ms;  // "total": the whole frame
 };
 using Runs = std::vector<std::pair<std::string, Run>>;  // in column order
@@ -107,6 +112,7 @@ Run RunRecognizer(const ModelLibrary& library, const RecognizerOptions& options,
                                            : recognizer.Recognize(frames[i].frame.rgbd);
     previous = result.detections;
     run.frames.push_back(EvaluateFrame(frames[i].name, result.detections, frames[i].frame.ground_truth, models));
+    run.detections.push_back(result.detections);
     for (const auto& [stage, ms] : result.timings_ms) run.stage_ms[stage].push_back(ms);
     Log(label, i, frames.size(), run.frames.back(), result.timings_ms.at("total"));
   }
@@ -119,6 +125,7 @@ Run RunPeer(RecognitionPeer& peer, const std::vector<NamedFrame>& frames, const 
   for (size_t i = 0; i < frames.size(); ++i) {
     const PeerResult result = peer.Recognize(frames[i].frame.rgbd);
     run.frames.push_back(EvaluateFrame(frames[i].name, result.detections, frames[i].frame.ground_truth, models));
+    run.detections.push_back(result.detections);
     run.stage_ms["total"].push_back(result.time_ms);
     run.stage_ms["scene"].push_back(result.scene_ms);
     run.stage_ms["scene points"].push_back(result.scene_points);
@@ -260,7 +267,9 @@ NamedFrame ObjectPixelsOnly(const NamedFrame& frame, const std::vector<PeerModel
   return masked;
 }
 
+const char* kOurs = "ECV + RANSAC + ICP";
 const char* kTracking = "ECV + RANSAC + ICP, tracking";
+const char* kFigureFrame = "0001/000001";  // --figure: the demo frame (models/frame)
 const char* kBytes = "ECV + RANSAC + ICP, --matcher bytes";
 const char* kPcl = "PCL FPFH + prerejective + ICP";
 const char* kPpf = "OpenCV PPF + ICP";
@@ -303,7 +312,7 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
   Runs runs;
   RecognizerOptions options;
   if (methods.ours) {
-    runs.emplace_back("ECV + RANSAC + ICP", RunRecognizer(library, options, frames, models, "icp"));
+    runs.emplace_back(kOurs, RunRecognizer(library, options, frames, models, "icp"));
     if (methods.threads > 1) {
       RecognizerOptions threaded = options;
       threaded.ransac.threads = methods.threads;
@@ -371,6 +380,46 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
   return runs;
 }
 
+// One picture of frame `name` per run of `labels` (those that ran), 2 per row, each with the run's detections
+// drawn by the recognizer (models in red, named) and a caption: what the picture in the README compares.
+cv::Mat DetectionsFigure(const std::string& db, const std::vector<NamedFrame>& frames, const Runs& runs,
+                         const std::string& name, const std::vector<std::string>& labels) {
+  const auto frame = std::find_if(frames.begin(), frames.end(), [&](const NamedFrame& f) { return f.name == name; });
+  if (frame == frames.end()) throw std::runtime_error("--figure: frame " + name + " is not among the frames run");
+  const auto index = static_cast<size_t>(frame - frames.begin());
+  const ModelLibrary library = ModelLibrary::Load(db);
+  Recognizer recognizer(library);
+  std::vector<cv::Mat> panels;
+  for (const std::string& label : labels) {
+    const auto run = std::find_if(runs.begin(), runs.end(), [&](const auto& r) { return r.first == label; });
+    if (run == runs.end()) continue;
+    const FrameEvaluation& evaluation = run->second.frames[index];
+    const auto found = std::count_if(evaluation.objects.begin(), evaluation.objects.end(),
+                                     [](const ObjectEvaluation& o) { return o.correct; });
+    cv::Mat panel = recognizer.DrawDetections(frame->frame.rgbd, run->second.detections[index]);
+    cv::rectangle(panel, cv::Rect(0, 0, panel.cols, 56), cv::Scalar(0, 0, 0), cv::FILLED);
+    const std::string caption = std::to_string(found) + " of " + std::to_string(evaluation.objects.size()) +
+                                " found, " + std::to_string(evaluation.false_positives) + " false";
+    cv::putText(panel, label, cv::Point(8, 22), cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(255, 255, 255), 1,
+                cv::LINE_AA);
+    cv::putText(panel, caption, cv::Point(8, 46), cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(255, 255, 255), 1,
+                cv::LINE_AA);
+    panels.push_back(panel);
+  }
+  if (panels.empty()) throw std::runtime_error("--figure: none of the compared runs ran");
+  while (panels.size() % 2 != 0) panels.push_back(cv::Mat::zeros(panels.front().size(), panels.front().type()));
+  std::vector<cv::Mat> rows;
+  for (size_t i = 0; i < panels.size(); i += 2) {
+    cv::Mat row;
+    cv::hconcat(panels[i], panels[i + 1], row);
+    rows.push_back(row);
+  }
+  cv::Mat figure;
+  cv::vconcat(rows, figure);
+  cv::resize(figure, figure, cv::Size(), 0.75, 0.75, cv::INTER_AREA);
+  return figure;
+}
+
 std::string PeerSettings(const PeerOptions& o) {
   std::ostringstream out;
   out << "Peers, whole frame (no masks, no ground truth), geometry only, one thread: model = points sampled on the "
@@ -415,7 +464,7 @@ std::string PeerSettings(const PeerOptions& o) {
 int main(int argc, char** argv) {
   using namespace ecv;
   using namespace ecv::bench;
-  std::string db, lmo_db, results = std::string(ECV_SOURCE_DIR) + "/bench/RESULTS.md";
+  std::string db, lmo_db, figure, results = std::string(ECV_SOURCE_DIR) + "/bench/RESULTS.md";
   int limit = 0, step = 1;
   Methods methods;
   PeerOptions peer_options;
@@ -457,6 +506,8 @@ int main(int argc, char** argv) {
       peer_options.ppf_scene_distance = std::atof(argv[++i]);
     } else if (has_value && std::strcmp(argv[i], "--min-inlier-fraction") == 0) {
       peer_options.min_inlier_fraction = std::atof(argv[++i]);
+    } else if (has_value && std::strcmp(argv[i], "--figure") == 0) {
+      figure = argv[++i];
     } else if (has_value && std::strcmp(argv[i], "--python") == 0) {
       methods.python = argv[++i];
     } else if (has_value && std::strcmp(argv[i], "--db") == 0) {
@@ -475,7 +526,7 @@ int main(int argc, char** argv) {
   if (db.empty()) {
     std::cerr
         << "usage: recognize_bench --db LIB.sqlite [--lmo-db LMO.sqlite] [--peers | --peers-only] [--object-pixels]\n"
-           "         [--track] [--search-every N] [--threads N] [--bytes] [--python EXE]\n"
+           "         [--track] [--search-every N] [--threads N] [--bytes] [--python EXE] [--figure F.jpg]\n"
            "         [--results FILE] [--frames N] [--frame-step S] [--ppf-sampling R] [--ppf-scene-distance R]\n"
            "         [--min-inlier-fraction F]\n"
            "  (build the libraries with scripts/build_ycbv_library LIB.sqlite --views 40 --distance 0.9 and\n"
@@ -487,6 +538,10 @@ int main(int argc, char** argv) {
     std::ostringstream markdown, notes;
     const std::vector<NamedFrame> frames = YcbvFrames(ECV_DATA_DIR, limit, step);
     const Runs runs = RunAll(db, frames, methods, peer_options, &notes);
+    if (!figure.empty()) {
+      WriteColorImage(figure, DetectionsFigure(db, frames, runs, kFigureFrame, {kOurs, kOpen3d, kPcl, kPpf}));
+      std::cerr << "recognize_bench: wrote " << figure << '\n';
+    }
     markdown << notes.str() << frames.size()
              << " YCB-Video frames (videos 0000-0002). Correct = ADD < 0.1 x diameter (ADD-S for symmetric models); "
                 "a false positive is a detection of a model not in the frame or a wrong pose.\n\n"
