@@ -8,9 +8,11 @@
 //   scripts/build_ycbv_library /tmp/ycbv.sqlite --views 40 --distance 0.9
 //   scripts/build_lmo_library /tmp/lmo.sqlite --views 40 --distance 1.0
 //   recognize_bench --db /tmp/ycbv.sqlite [--lmo-db /tmp/lmo.sqlite] [--peers] [--track] [--search-every N]
-//                   [--threads N] [--bytes] [--python EXE] [--figure F.jpg] [--results bench/RESULTS.md] [--frames N]
+//                   [--threads N] [--bytes] [--preselect N] [--python EXE] [--figure F.jpg]
+//                   [--results bench/RESULTS.md] [--frames N]
 // --threads N (N > 1) adds a run of ours with N worker threads: the same detections (checked), its own times.
 // --bytes adds a run of ours matching with ByteNeighbours (recognize --matcher bytes; needs AVX-512 VNNI).
+// --preselect N adds a run of ours searching only the N models a quick look scores best (recognize --preselect N).
 // --track adds a run with the previous frame's detections as priors; --search-every N (N > 1) one more where
 // only every N-th frame of a video searches the models that are not tracked (recognize --search-every).
 // --figure F.jpg draws the detections of ours and each peer in frame 0001/000001 (the demo frame) side by side.
@@ -207,7 +209,8 @@ std::string RecallTable(const Runs& runs) {
 std::string TimingTable(const Run& run) {
   std::ostringstream out;
   out << "| stage | median ms per frame | mean ms per frame |\n|---|---:|---:|\n";
-  for (const char* stage : {"extract", "describe", "track", "rank", "match", "ransac", "verify", "refine", "total"}) {
+  for (const char* stage :
+       {"extract", "describe", "track", "preselect", "rank", "match", "ransac", "verify", "refine", "total"}) {
     const auto found = run.stage_ms.find(stage);
     if (found != run.stage_ms.end()) {
       out << "| " << stage << " | " << Fixed(Median(found->second), 1) << " | " << Fixed(Mean(found->second), 1)
@@ -275,6 +278,11 @@ const char* kPcl = "PCL FPFH + prerejective + ICP";
 const char* kPpf = "OpenCV PPF + ICP";
 const char* kOpen3d = "Open3D FPFH + RANSAC + ICP";
 
+// The label of a search of the `n` pre-selected models.
+std::string Preselecting(int n) {
+  return std::string(kOurs) + ", --preselect " + std::to_string(n);
+}
+
 // The label of tracking with a full search every `n`-th frame.
 std::string TrackingEvery(int n) {
   return std::string(kTracking) + ", full search every " + std::to_string(n) + " frames";
@@ -290,10 +298,11 @@ struct Methods {
   bool ours = true;                         ///< ECV with and without ICP
   bool track = false;                       ///< ours also with the previous frame's detections as priors
   int search_every = 1;                     ///< > 1: ours also tracking with a full search only every n-th frame
-  bool peers = false;                       ///< PCL and OpenCV PPF on the whole frames
+  bool peers = false;                       ///< PCL, OpenCV PPF and Open3D on the whole frames
   bool object_pixels = false;               ///< the peers also on the objects' pixels only
   std::string python = "/usr/bin/python3";  ///< the interpreter that runs the Open3D peer
   bool bytes = false;  ///< ours also with MatchIndex::kBytes (recognize --matcher bytes; AVX-512 VNNI only)
+  int preselect = 0;   ///< > 0: ours also searching only this many pre-selected models (recognize --preselect)
   int threads = 1;     ///< > 1: ours also with this many worker threads (the same detections, faster)
 };
 
@@ -325,6 +334,12 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
       RecognizerOptions bytes = options;
       bytes.match.index = MatchIndex::kBytes;
       runs.emplace_back(kBytes, RunRecognizer(library, bytes, frames, models, "bytes"));
+    }
+    if (methods.preselect > 0) {
+      RecognizerOptions preselecting = options;
+      preselecting.preselect_models = methods.preselect;
+      runs.emplace_back(Preselecting(methods.preselect),
+                        RunRecognizer(library, preselecting, frames, models, "preselect"));
     }
     if (methods.track) {
       runs.emplace_back(kTracking, RunRecognizer(library, options, frames, models, "track", true));
@@ -489,6 +504,12 @@ int main(int argc, char** argv) {
         return 2;
       }
       methods.bytes = true;
+    } else if (has_value && std::strcmp(argv[i], "--preselect") == 0) {
+      methods.preselect = std::atoi(argv[++i]);
+      if (methods.preselect < 1) {
+        db.clear();
+        break;
+      }
     } else if (std::strcmp(argv[i], "--track") == 0) {
       methods.track = true;
     } else if (has_value && std::strcmp(argv[i], "--search-every") == 0) {
@@ -526,7 +547,8 @@ int main(int argc, char** argv) {
   if (db.empty()) {
     std::cerr
         << "usage: recognize_bench --db LIB.sqlite [--lmo-db LMO.sqlite] [--peers | --peers-only] [--object-pixels]\n"
-           "         [--track] [--search-every N] [--threads N] [--bytes] [--python EXE] [--figure F.jpg]\n"
+           "         [--track] [--search-every N] [--threads N] [--bytes] [--preselect N] [--python EXE]\n"
+           "         [--figure F.jpg]\n"
            "         [--results FILE] [--frames N] [--frame-step S] [--ppf-sampling R] [--ppf-scene-distance R]\n"
            "         [--min-inlier-fraction F]\n"
            "  (build the libraries with scripts/build_ycbv_library LIB.sqlite --views 40 --distance 0.9 and\n"
@@ -552,6 +574,11 @@ int main(int argc, char** argv) {
       markdown << "\nThe same matching with ByteNeighbours (`recognize --matcher bytes`: every scene descriptor "
                   "compared over 7-bit values, AVX-512 VNNI):\n\n"
                << TimingTable(RunNamed(runs, kBytes));
+    }
+    if (methods.ours && methods.preselect > 0) {
+      markdown << "\nThe same searching only the " << methods.preselect
+               << " models that a quick look scores best (`recognize --preselect " << methods.preselect << "`):\n\n"
+               << TimingTable(RunNamed(runs, Preselecting(methods.preselect)));
     }
     if (methods.ours && methods.track) {
       markdown << "\nThe same with tracking (each frame gets the previous frame's detections of its video as priors; "

@@ -209,6 +209,9 @@ void RecognizerOptions::Check() const {
   consistency.Check();
   plane_patch.Check();
   require(consistency_max_correspondences >= 3, "consistency_max_correspondences", "at least 3");
+  require(preselect_models >= 0, "preselect_models", ">= 0 (0: search every model)");
+  require(preselect_view_stride >= 1, "preselect_view_stride", "at least 1");
+  require(preselect_rows >= 3, "preselect_rows", "at least 3");
   require(ranking_checks >= 0, "ranking_checks", "0 (match.checks) or more");
   require(dense_stride_px >= 1, "dense_stride_px", "at least 1");
   require(ransac_stride_px >= 1, "ransac_stride_px", "at least 1");
@@ -336,6 +339,11 @@ class Recognizer::Impl {
       done[m] = instances(m) >= options_.max_instances || (scope == SearchScope::kLostTracks && lost[m] == 0);
     }
     if (std::count(done.begin(), done.end(), false) > 0) DescribeScene(&scene, &result);  // none when all tracked
+    if (options_.preselect_models > 0 && std::count(done.begin(), done.end(), false) > options_.preselect_models) {
+      stage = Clock::now();
+      Preselect(scene, &done);
+      result.timings_ms["preselect"] = MillisecondsSince(stage);
+    }
     // The models on RansacOptions::threads workers: a model's search depends on nothing
     // of the others', so the detections do not depend on the count. Stage times are summed over the workers.
     // Fewer models to search than workers (a one-model library, say): the spare ones share each RANSAC's blocks.
@@ -526,6 +534,38 @@ class Recognizer::Impl {
       rival = &candidate;
     }
     return rival;
+  }
+
+  // Marks done all but the preselect_models models (of those not done) with the largest consistent set over every
+  // preselect_view_stride-th view, on the first preselect_rows of each view's ranking rows; ties go to the earlier.
+  void Preselect(const Scene& scene, std::vector<bool>* done) const {
+    std::vector<size_t> candidates;
+    for (size_t m = 0; m < done->size(); ++m) {
+      if (!(*done)[m]) candidates.push_back(m);
+    }
+    std::vector<int> quick(candidates.size(), 0);
+    if (scene.matcher) {
+      ParallelFor(candidates.size(), options_.ransac.threads, [&](size_t i) {
+        const ModelRecord& record = records_[candidates[i]];
+        ConsistencyOptions consistency = options_.consistency;
+        consistency.max_distance_m = record.diameter_m;
+        for (size_t v = 0; v < record.views.size(); v += static_cast<size_t>(options_.preselect_view_stride)) {
+          const ModelView& view = record.views[v];
+          if (view.descriptors.values.rows == 0) continue;
+          std::vector<int> rows = RankingRows(candidates[i], v).ranking;
+          rows.resize(std::min(rows.size(), static_cast<size_t>(options_.preselect_rows)));
+          const std::vector<Correspondence> matches =
+              Correspondences(view, CopyRows(view.descriptors, rows), scene, RankingChecks());
+          quick[i] = std::max(quick[i], ConsistentSetSize(view.primitives, scene.primitives, matches, consistency));
+        }
+      });
+    }
+    std::vector<size_t> order(candidates.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return quick[a] > quick[b]; });
+    for (size_t i = static_cast<size_t>(options_.preselect_models); i < order.size(); ++i) {
+      (*done)[candidates[order[i]]] = true;
+    }
   }
 
   // The model's views, best ranked first, each with the correspondences of its ranking subset of descriptors.

@@ -92,6 +92,43 @@ TEST_F(RecognizeEndToEnd, FindsTheObjectsOfTheDemoFrameWithinTenthOfTheirDiamete
 
 // The speed options: exact matching over 7-bit descriptors (plain loop or VNNI, the same matches) and view ranking
 // with fewer checks still find the demo frame's three objects; an unknown matcher is named.
+// Pre-selection (RecognizerOptions::preselect_models): of the three models, all in the frame, exactly the two
+// kept are searched, both found at their true poses and nothing else reported; keeping as many as there are
+// models changes nothing. A negative count is refused, naming the option.
+TEST_F(RecognizeEndToEnd, PreselectionSearchesOnlyTheBestScoringModels) {
+  const LoadedFrame frame = LoadYcbvFrame(Frame());
+  const ModelLibrary library = Library();
+  const std::vector<EvalModel> models = EvalModels(library);
+  RecognizerOptions options;
+  options.preselect_models = 2;
+  Recognizer preselecting(library, options);
+  const RecognitionResult kept = preselecting.Recognize(frame.rgbd);
+  EXPECT_EQ(kept.views_tried.size(), 2U);
+  EXPECT_EQ(kept.timings_ms.count("preselect"), 1U);
+  const FrameEvaluation evaluation = EvaluateFrame("0001/000001", kept.detections, frame.ground_truth, models);
+  EXPECT_EQ(evaluation.false_positives, 0);
+  ASSERT_EQ(kept.detections.size(), 2U);
+  for (const ObjectEvaluation& object : evaluation.objects) {
+    const bool searched = kept.views_tried.count(object.model) == 1;
+    EXPECT_EQ(object.correct, searched) << object.model;
+  }
+
+  options.preselect_models = 3;
+  const RecognitionResult all = Recognizer(library, options).Recognize(frame.rgbd);
+  const RecognitionResult plain = Recognizer(library).Recognize(frame.rgbd);
+  EXPECT_EQ(all.views_tried, plain.views_tried);
+  EXPECT_EQ(all.timings_ms.count("preselect"), 0U);
+  ASSERT_EQ(all.detections.size(), plain.detections.size());
+  for (size_t i = 0; i < all.detections.size(); ++i) {
+    EXPECT_EQ(all.detections[i].model, plain.detections[i].model);
+    EXPECT_TRUE(all.detections[i].camera_from_object.isApprox(plain.detections[i].camera_from_object));
+  }
+
+  const test::CommandResult bad = test::RunCli("recognize --db " + library_ + " " + Frame() + " --preselect -1");
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.output.find("preselect_models"), std::string::npos) << bad.output;
+}
+
 TEST_F(RecognizeEndToEnd, TheBytesMatcherAndFewerRankingChecksFindTheDemoFramesObjects) {
   const LoadedFrame frame = LoadYcbvFrame(Frame());
   const std::vector<EvalModel> models = EvalModels(Library());
