@@ -260,7 +260,7 @@ CommandAction SetupRecognizeCommand(CLI::App& command) {
   command
       .add_option("--preselect", options.preselect_models,
                   "Search only the N models that a quick look at every 4th view (100 descriptors each) scores best, "
-                  "for large libraries (0: every model; 16 YCB-Video models, N = 6: 0.52x the time, 61 instead of "
+                  "for large libraries (0: every model; 16 YCB-Video models, N = 6: 0.53x the time, 61 instead of "
                   "68 of 130 objects)")
       ->capture_default_str();
   command
