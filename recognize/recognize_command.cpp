@@ -148,9 +148,8 @@ int RunRecognize(const RecognizeArgs& args) {
   if (options.match.index == MatchIndex::kBytes) {
     std::cerr << "bytes (" << (ByteNeighbours::CpuHasVnni() ? "AVX-512 VNNI" : "plain loop") << ", exact)\n";
   } else {
-    const int ranking_checks = options.ranking_checks > 0 ? options.ranking_checks : options.match.checks;
     std::cerr << "kd-forest (" << options.match.trees << " trees, " << options.match.checks << " checks; view ranking "
-              << ranking_checks << ")\n";
+              << options.RankingChecks() << ")\n";
   }
 
   if (single) {

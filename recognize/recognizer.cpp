@@ -555,7 +555,7 @@ class Recognizer::Impl {
           std::vector<int> rows = RankingRows(candidates[i], v).ranking;
           rows.resize(std::min(rows.size(), static_cast<size_t>(options_.preselect_rows)));
           const std::vector<Correspondence> matches =
-              Correspondences(view, CopyRows(view.descriptors, rows), scene, RankingChecks());
+              Correspondences(view, CopyRows(view.descriptors, rows), scene, options_.RankingChecks());
           quick[i] = std::max(quick[i], ConsistentSetSize(view.primitives, scene.primitives, matches, consistency));
         }
       });
@@ -579,8 +579,8 @@ class Recognizer::Impl {
       ViewCandidate candidate;
       candidate.view = static_cast<int>(v);
       // Scored on a seeded subset of the view's descriptors, for speed.
-      candidate.correspondences =
-          Correspondences(view, CopyRows(view.descriptors, RankingRows(model, v).ranking), scene, RankingChecks());
+      candidate.correspondences = Correspondences(view, CopyRows(view.descriptors, RankingRows(model, v).ranking),
+                                                  scene, options_.RankingChecks());
       ConsistencyOptions consistency = options_.consistency;
       consistency.max_distance_m = record.diameter_m;
       candidate.score = ConsistentSetSize(view.primitives, scene.primitives, candidate.correspondences, consistency);
@@ -597,9 +597,6 @@ class Recognizer::Impl {
                      static_cast<size_t>(options_.consistency_max_correspondences), options_.ransac.seed + view);
   }
 
-  // Compared descriptors per ranking query.
-  int RankingChecks() const { return options_.ranking_checks > 0 ? options_.ranking_checks : options_.match.checks; }
-
   // Gives `candidate` its correspondences, once: the nearest scene descriptor of each of its descriptors (paper:
   // object to scene). The ranking has matched a subset of them; when it searched as matching does (or the search
   // is exact, MatchIndex::kBytes), only the others are searched here. The correspondences are put in the order in which
@@ -608,7 +605,8 @@ class Recognizer::Impl {
     if (candidate->matched) return;
     const auto view = static_cast<size_t>(candidate->view);
     const ModelView& model_view = records_[model].views[view];
-    const bool reuse_ranking = RankingChecks() == options_.match.checks || options_.match.index == MatchIndex::kBytes;
+    const bool reuse_ranking =
+        options_.RankingChecks() == options_.match.checks || options_.match.index == MatchIndex::kBytes;
     std::vector<Correspondence> found;
     if (reuse_ranking) {
       found = Correspondences(model_view, CopyRows(model_view.descriptors, RankingRows(model, view).rest), scene);

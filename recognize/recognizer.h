@@ -218,6 +218,8 @@ struct RecognizerOptions {
   static MatchOptions DefaultMatch();
   /// Throws InputError on values outside their ranges.
   void Check() const;
+  /// Compared descriptors per view-ranking query: ranking_checks, or match.checks when it is 0.
+  int RankingChecks() const { return ranking_checks > 0 ? ranking_checks : match.checks; }
 };
 
 /// One recognised object (the JSON of DESIGN.md "Interfaces").
