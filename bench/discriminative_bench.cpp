@@ -10,10 +10,12 @@
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <functional>
 #include <iostream>
 #include <map>
 #include <random>
+#include <stdexcept>
 #include <tuple>
 
 #include <opencv2/imgcodecs.hpp>
@@ -112,12 +114,21 @@ PairPrimitives Extract(const ViewPair& pair, const EcvOptions& options) {
           ExtractPrimitives(pair.train.rgbd, options, pair.clutter ? cv::Mat() : pair.train.mask).primitives};
 }
 
+// The pixels a peer's train keypoints and descriptors draw on: the object's, or the whole frame for a cluttered
+// pair.
+cv::Mat TrainSupport(const ViewPair& pair) {
+  return pair.clutter ? cv::Mat(pair.train.mask.size(), CV_8UC1, cv::Scalar(255)) : pair.train.mask;
+}
+
 // ECV context descriptors matched with ecvpose's own matcher.
 PairScore ScoreEcv(const ViewPair& pair, const PairPrimitives& primitives, const DescriptorOptions& descriptor,
                    const MatchOptions& matching) {
   const Clock::time_point start = Clock::now();
-  const Descriptors query = ComputeDescriptors(primitives.query, descriptor);
-  const Descriptors train = ComputeDescriptors(primitives.train, descriptor);
+  // The surface context's support: the pixels the peers use.
+  const SurfaceSamples query_surface = DescriptorSurface(pair.query.rgbd, descriptor, pair.query.mask);
+  const SurfaceSamples train_surface = DescriptorSurface(pair.train.rgbd, descriptor, TrainSupport(pair));
+  const Descriptors query = ComputeDescriptors(primitives.query, descriptor, 1, 1, &query_surface);
+  const Descriptors train = ComputeDescriptors(primitives.train, descriptor, 1, 1, &train_surface);
   PairScore result;
   result.describe_ms = MillisecondsSince(start);
   if (query.primitive.empty() || train.primitive.empty()) return result;
@@ -140,12 +151,6 @@ std::vector<Eigen::Vector3f> Positions(const std::vector<Primitive>& primitives)
   return positions;
 }
 
-// The pixels a peer's train keypoints and descriptors draw on: the object's, or the whole frame for a cluttered
-// pair.
-cv::Mat TrainSupport(const ViewPair& pair) {
-  return pair.clutter ? cv::Mat(pair.train.mask.size(), CV_8UC1, cv::Scalar(255)) : pair.train.mask;
-}
-
 using Method = std::function<PairScore(const ViewPair&, const PairPrimitives&)>;
 
 std::vector<std::pair<std::string, Method>> Methods() {
@@ -155,6 +160,12 @@ std::vector<std::pair<std::string, Method>> Methods() {
   methods.emplace_back("ECV source pairs, 4 shells, r 4.5 cm (library default)",
                        [](const ViewPair& pair, const PairPrimitives& p) {
                          return ScoreEcv(pair, p, DescriptorOptions::SourceShells(), {});
+                       });
+  methods.emplace_back("ECV surface context, 4 shells, r 4.5 cm, mixed matching",
+                       [](const ViewPair& pair, const PairPrimitives& p) {
+                         MatchOptions mixed;
+                         mixed.structure_specific = false;
+                         return ScoreEcv(pair, p, DescriptorOptions::SurfaceShells(), mixed);
                        });
   auto add_pcl = [&](PclDescriptor descriptor, double radius_m, const std::string& suffix) {
     methods.emplace_back(
@@ -223,6 +234,13 @@ std::string SetTable(const std::string& set, const std::vector<ViewPair>& pairs,
   table += "| **mean** | |";
   for (const double value : mean) table += " **" + Percent(value) + "** |";
   return table + "\n\n";
+}
+
+// Writes a BGR image; a path that cannot be written ends the run with its name (cv::imwrite only returns false).
+void WriteImage(const std::string& path, const cv::Mat& image) {
+  if (!cv::imwrite(path, image, {cv::IMWRITE_JPEG_QUALITY, 85})) {
+    throw std::runtime_error("discriminative_bench: cannot write the figure " + path);
+  }
 }
 
 // Bar chart of the mean score per method and set, random matching as a grey tick (BGR image for imwrite).
@@ -392,6 +410,25 @@ std::vector<Variant> Variants() {
          [](Variant& v) { v.descriptor.balance_colors = true; });
   source(", 4 shells, radius 0.045 m, mixed matching", 4, 0.045,
          [](Variant& v) { v.matching.structure_specific = false; });
+  source(", 4 shells, radius 0.045 m, unsigned segments", 4, 0.045,
+         [](Variant& v) { v.descriptor.unsigned_segments = true; });
+  // The surface context (DescriptorShape::kSurface): a hybrid whose shape histograms come from the depth image's
+  // surface in a local reference frame, the colour ones from the primitives.
+  auto surface = [&](const std::string& name, double radius, double weight, bool mixed, bool color) {
+    source(", 4 shells, radius " + Fixed(radius, 3) + " m, surface context" + name, 4, radius, [=](Variant& v) {
+      v.descriptor.shape = DescriptorShape::kSurface;
+      v.descriptor.surface_weight = weight;
+      v.descriptor.use_color = color;
+      v.matching.structure_specific = !mixed;
+    });
+  };
+  surface("", 0.045, 2.0, false, true);
+  surface(", mixed matching", 0.045, 2.0, true, true);
+  surface(", mixed matching, weight 1", 0.045, 1.0, true, true);
+  surface(", mixed matching, weight 4", 0.045, 4.0, true, true);
+  surface(", mixed matching, no colour", 0.045, 2.0, true, false);
+  surface(", mixed matching", 0.035, 2.0, true, true);
+  surface(", mixed matching", 0.055, 2.0, true, true);
   return variants;
 }
 
@@ -412,11 +449,13 @@ bool SameExtraction(const EcvOptions& a, const EcvOptions& b) {
          a.min_magnitude == b.min_magnitude && a.max_edge_variance == b.max_edge_variance && a.edge_nms == b.edge_nms;
 }
 
-// The primitives of a dense close-up frame (YCB-Video 0000/000001, whole image) for the descriptor time.
+// A dense close-up frame (YCB-Video 0000/000001, whole image) for the descriptor time.
+RgbdFrame DenseFrame() {
+  return LoadYcbvFrame(std::string(ECV_DATA_DIR) + "/ycbv_subset/Example-Scenes/0000/000001").rgbd;
+}
+
 std::vector<Primitive> DenseFramePrimitives(const EcvOptions& options) {
-  return ExtractPrimitives(LoadYcbvFrame(std::string(ECV_DATA_DIR) + "/ycbv_subset/Example-Scenes/0000/000001").rgbd,
-                           options)
-      .primitives;
+  return ExtractPrimitives(DenseFrame(), options).primitives;
 }
 
 // Mean ECV score of each variant per set, on the tuning pairs (videos 0000, 0001) and the held-out ones,
@@ -426,18 +465,20 @@ std::string AblationTable(const std::vector<ViewPair>& pairs, const std::vector<
   const std::vector<Primitive> dense = DenseFramePrimitives({});
   std::string table =
       "### Ablations of the ECV context descriptor (mean score %, tuning = videos 0000 and 0001, held out = 0002)\n\n"
+      "mean per object: as the set tables above (each object's mean over its pairs, then the mean over the objects); "
       "in clutter: the recognition pairs matched against every primitive of the real frame, their contexts among all "
       "of them; describe ms/view: mean over the views cut to their object; dense frame: YCB-Video 0000/000001, whole "
       "image (" +
       std::to_string(dense.size()) +
       " primitives with the default extraction).\n\n"
-      "| variant | recognition tuning | recognition held out | in clutter tuning | in clutter held out | "
-      "hard (held out) | easy tuning | easy held out | "
+      "| variant | recognition, mean per object | hard, mean per object | recognition tuning | recognition held out | "
+      "in clutter tuning | in clutter held out | hard (held out) | easy tuning | easy held out | "
       "describe ms/view | describe ms, dense frame |\n"
-      "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+      "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const Variant& variant : Variants()) {
     if (!MatchesFilter(variant.name, filter)) continue;
-    std::map<std::string, std::pair<double, int>> sums;  // key: set + tuning/held-out
+    std::map<std::string, std::pair<double, int>> sums;                              // key: set + tuning/held-out
+    std::map<std::string, std::map<std::string, std::pair<double, int>>> by_object;  // set -> object -> sum, count
     const bool same_extraction = SameExtraction(variant.extraction, EcvOptions{});
     double describe_ms = 0.0;  // of the views cut to the object
     int described_views = 0;
@@ -451,18 +492,36 @@ std::string AblationTable(const std::vector<ViewPair>& pairs, const std::vector<
       auto& [sum, count] = sums[pairs[i].set + (pairs[i].held_out ? "/held" : "/tune")];
       sum += score.score;
       ++count;
+      auto& [object_sum, object_count] = by_object[pairs[i].set][pairs[i].object];
+      object_sum += score.score;
+      ++object_count;
     }
-    const Clock::time_point start = Clock::now();
-    ComputeDescriptors(same_extraction ? dense : DenseFramePrimitives(variant.extraction), variant.descriptor);
+    // The main tables' figure: the mean over objects of each object's mean over its pairs.
+    auto object_mean = [&](const std::string& set) {
+      double total = 0.0;
+      for (const auto& [object, sum_count] : by_object[set]) {
+        total += sum_count.first / sum_count.second;
+        if (std::getenv("ECV_PER_OBJECT") != nullptr) {
+          std::cerr << set << " " << object << " " << Percent(sum_count.first / sum_count.second) << "\n";
+        }
+      }
+      return by_object[set].empty() ? std::string("") : Percent(total / static_cast<double>(by_object[set].size()));
+    };
+    const std::vector<Primitive> dense_primitives = same_extraction ? dense : DenseFramePrimitives(variant.extraction);
+    const RgbdFrame dense_frame = DenseFrame();
+    const Clock::time_point start = Clock::now();  // the surface context's sampling counts too
+    const SurfaceSamples surface = DescriptorSurface(dense_frame, variant.descriptor);
+    ComputeDescriptors(dense_primitives, variant.descriptor, 1, 1, &surface);
     const double dense_ms = MillisecondsSince(start);
     auto mean = [&](const std::string& key) {
       const auto found = sums.find(key);
       return found == sums.end() ? std::string("") : Percent(found->second.first / found->second.second);
     };
-    table += "| " + variant.name + " | " + mean("recognition/tune") + " | " + mean("recognition/held") + " | " +
-             mean("recognition in clutter/tune") + " | " + mean("recognition in clutter/held") + " | " +
-             mean("hard/held") + " | " + mean("easy/tune") + " | " + mean("easy/held") + " | " +
-             Fixed(describe_ms / std::max(described_views, 1), 1) + " | " + Fixed(dense_ms, 0) + " |\n";
+    table += "| " + variant.name + " | " + object_mean("recognition") + " | " + object_mean("hard") + " | " +
+             mean("recognition/tune") + " | " + mean("recognition/held") + " | " + mean("recognition in clutter/tune") +
+             " | " + mean("recognition in clutter/held") + " | " + mean("hard/held") + " | " + mean("easy/tune") +
+             " | " + mean("easy/held") + " | " + Fixed(describe_ms / std::max(described_views, 1), 1) + " | " +
+             Fixed(dense_ms, 0) + " |\n";
     std::cerr << '.' << std::flush;
   }
   return table + "\n";
@@ -527,12 +586,13 @@ int main(int argc, char** argv) {
   }
   report += ablations;
   report += "![bar chart](figures/descriptor_scores.png)\n\n![matches](figures/descriptor_matches.jpg)\n\n";
-  cv::imwrite(figures + "/descriptor_scores.png", BarChart(pairs, names, scores));
+  std::filesystem::create_directories(figures);
+  WriteImage(figures + "/descriptor_scores.png", BarChart(pairs, names, scores));
   for (size_t i = 0; i < pairs.size(); ++i) {  // a recognition pair of the cracker box
     if (pairs[i].set == "recognition" && pairs[i].object == "003_cracker_box") {
       cv::Mat picture = MatchPicture(pairs[i], primitives[i]);
       cv::resize(picture, picture, cv::Size(), 0.75, 0.75, cv::INTER_AREA);
-      cv::imwrite(figures + "/descriptor_matches.jpg", picture, {cv::IMWRITE_JPEG_QUALITY, 85});
+      WriteImage(figures + "/descriptor_matches.jpg", picture);
       break;
     }
   }

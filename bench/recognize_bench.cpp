@@ -8,11 +8,12 @@
 //   scripts/build_ycbv_library /tmp/ycbv.sqlite --views 40 --distance 0.9
 //   scripts/build_lmo_library /tmp/lmo.sqlite --views 40 --distance 1.0
 //   recognize_bench --db /tmp/ycbv.sqlite [--lmo-db /tmp/lmo.sqlite] [--peers] [--track] [--search-every N]
-//                   [--threads N] [--bytes] [--preselect N] [--python EXE] [--figure F.jpg]
+//                   [--threads N] [--bytes] [--preselect N] [--turned] [--python EXE] [--figure F.jpg]
 //                   [--results bench/RESULTS.md] [--frames N]
 // --threads N (N > 1) adds a run of ours with N worker threads: the same detections (checked), its own times.
 // --bytes adds a run of ours matching with ByteNeighbours (recognize --matcher bytes; needs AVX-512 VNNI).
 // --preselect N adds a run of ours searching only the N models a quick look scores best (recognize --preselect N).
+// --turned adds a run of ours on the same frames turned 180 degrees (a camera held upside down; ground truth moved).
 // --track adds a run with the previous frame's detections as priors; --search-every N (N > 1) one more where
 // only every N-th frame of a video searches the models that are not tracked (recognize --search-every).
 // --figure F.jpg draws the detections of ours and each peer in frame 0001/000001 (the demo frame) side by side.
@@ -57,6 +58,28 @@ std::vector<NamedFrame> YcbvFrames(const std::string& data, int limit, int step)
                       LoadYcbvFrame(prefix)});
   }
   return frames;
+}
+
+// The `frames` as the same camera held upside down sees them (TurnUpsideDown), with their ground truth moved
+// along: recognition should not depend on the camera's roll about its optical axis.
+std::vector<NamedFrame> TurnedFrames(const std::vector<NamedFrame>& frames) {
+  std::vector<NamedFrame> turned;
+  for (const NamedFrame& named : frames) {
+    NamedFrame copy{named.name, {TurnUpsideDown(named.frame.rgbd), named.frame.ground_truth}};
+    const cv::Size size = named.frame.rgbd.color.size();
+    const auto turn_box = [&](const cv::Rect& box) {
+      return box.empty()
+                 ? box
+                 : cv::Rect(size.width - box.x - box.width, size.height - box.y - box.height, box.width, box.height);
+    };
+    for (GroundTruth& truth : copy.frame.ground_truth) {
+      truth.camera_from_object = TurnedFromCamera() * truth.camera_from_object;
+      truth.object_box = turn_box(truth.object_box);
+      truth.visible_box = turn_box(truth.visible_box);
+    }
+    turned.push_back(std::move(copy));
+  }
+  return turned;
 }
 
 std::vector<NamedFrame> LmoFrames(const std::string& data) {
@@ -272,6 +295,7 @@ NamedFrame ObjectPixelsOnly(const NamedFrame& frame, const std::vector<PeerModel
 
 const char* kOurs = "ECV + RANSAC + ICP";
 const char* kTracking = "ECV + RANSAC + ICP, tracking";
+const char* kTurned = "ECV + RANSAC + ICP, frames turned 180 degrees";
 const char* kFigureFrame = "0001/000001";  // --figure: the demo frame (models/frame)
 const char* kBytes = "ECV + RANSAC + ICP, --matcher bytes";
 const char* kPcl = "PCL FPFH + prerejective + ICP";
@@ -301,9 +325,10 @@ struct Methods {
   bool peers = false;                       ///< PCL, OpenCV PPF and Open3D on the whole frames
   bool object_pixels = false;               ///< the peers also on the objects' pixels only
   std::string python = "/usr/bin/python3";  ///< the interpreter that runs the Open3D peer
-  bool bytes = false;  ///< ours also with MatchIndex::kBytes (recognize --matcher bytes; AVX-512 VNNI only)
-  int preselect = 0;   ///< > 0: ours also searching only this many pre-selected models (recognize --preselect)
-  int threads = 1;     ///< > 1: ours also with this many worker threads (the same detections, faster)
+  bool bytes = false;   ///< ours also with MatchIndex::kBytes (recognize --matcher bytes; AVX-512 VNNI only)
+  int preselect = 0;    ///< > 0: ours also searching only this many pre-selected models (recognize --preselect)
+  int threads = 1;      ///< > 1: ours also with this many worker threads (the same detections, faster)
+  bool turned = false;  ///< ours also on the frames turned 180 degrees (a camera held upside down)
 };
 
 // The `methods` on `frames` with the library at `db`.
@@ -322,6 +347,8 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
   RecognizerOptions options;
   if (methods.ours) {
     runs.emplace_back(kOurs, RunRecognizer(library, options, frames, models, "icp"));
+    if (methods.turned)
+      runs.emplace_back(kTurned, RunRecognizer(library, options, TurnedFrames(frames), models, "turned"));
     if (methods.threads > 1) {
       RecognizerOptions threaded = options;
       threaded.ransac.threads = methods.threads;
@@ -510,6 +537,8 @@ int main(int argc, char** argv) {
         db.clear();
         break;
       }
+    } else if (std::strcmp(argv[i], "--turned") == 0) {
+      methods.turned = true;
     } else if (std::strcmp(argv[i], "--track") == 0) {
       methods.track = true;
     } else if (has_value && std::strcmp(argv[i], "--search-every") == 0) {
@@ -547,7 +576,7 @@ int main(int argc, char** argv) {
   if (db.empty()) {
     std::cerr
         << "usage: recognize_bench --db LIB.sqlite [--lmo-db LMO.sqlite] [--peers | --peers-only] [--object-pixels]\n"
-           "         [--track] [--search-every N] [--threads N] [--bytes] [--preselect N] [--python EXE]\n"
+           "         [--track] [--search-every N] [--threads N] [--bytes] [--preselect N] [--turned] [--python EXE]\n"
            "         [--figure F.jpg]\n"
            "         [--results FILE] [--frames N] [--frame-step S] [--ppf-sampling R] [--ppf-scene-distance R]\n"
            "         [--min-inlier-fraction F]\n"

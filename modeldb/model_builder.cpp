@@ -93,7 +93,10 @@ ModelView BuildModelView(Renderer& renderer, MeshId mesh, const Eigen::Isometry3
   MoveIntoObjectFrame(camera_from_object.inverse(), &view.primitives);
   time.extract_ms += MillisecondsSince(start);
   start = Clock::now();
-  view.descriptors = ComputeDescriptors(view.primitives, options.features.descriptor, options.threads);
+  // The surface context's support (if any), in the object frame as the primitives are.
+  const SurfaceSamples surface = MovedSurface(DescriptorSurface(frame, options.features.descriptor, rendered.mask),
+                                              camera_from_object.inverse().cast<float>());
+  view.descriptors = ComputeDescriptors(view.primitives, options.features.descriptor, options.threads, 1, &surface);
   time.describe_ms += MillisecondsSince(start);
   return view;
 }

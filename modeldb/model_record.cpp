@@ -38,6 +38,8 @@ void VisitFields(Settings& settings, Visit visit) {
   visit("descriptor", "appearance", d.appearance);  // DescriptorAppearance as its integer value
   visit("descriptor", "closeness_weight", d.closeness_weight);
   visit("descriptor", "shells", d.shells);
+  visit("descriptor", "shape", d.shape);  // DescriptorShape as its integer value
+  visit("descriptor", "surface_weight", d.surface_weight);
 }
 
 nlohmann::ordered_json ToJson(const FeatureSettings& settings) {

@@ -339,7 +339,9 @@ void AddBuildFlags(CLI::App& build, ModeldbArgs* args) {
       ->check(NonNegative());
   build.add_option("--feature-settings", args->feature_settings,
                    "JSON of extraction and descriptor settings, {\"ecv\": {...}, \"descriptor\": {...}} as "
-                   "`modeldb info` shows them (missing fields: defaults)");
+                   "`modeldb info` shows them (missing fields: defaults); for a camera not held level, "
+                   "{\"descriptor\": {\"unsigned_segments\": true}} (README: the camera's roll), or the surface "
+                   "context, {\"descriptor\": {\"shape\": 1}}");
   build.footer(
       "A directory holds one folder per model, <name>/<name>.obj, with object_from_mesh.json beside the mesh when\n"
       "the mesh's frame differs from the object frame; --object-from-mesh FILE overrides those for every mesh.\n"

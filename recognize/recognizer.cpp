@@ -458,7 +458,9 @@ class Recognizer::Impl {
     result->timings_ms["extract"] = MillisecondsSince(stage);
 
     stage = Clock::now();
-    scene->descriptors = ComputeSceneDescriptors(scene->primitives, settings.descriptor, options_);
+    // The surface context's support (if any): the whole frame's surface.
+    const SurfaceSamples surface = DescriptorSurface(frame, settings.descriptor);
+    scene->descriptors = ComputeSceneDescriptors(scene->primitives, settings.descriptor, options_, &surface);
     if (scene->descriptors.values.rows > 0) {
       scene->matcher = std::make_unique<DescriptorMatcher>(scene->primitives, scene->descriptors, options_.match);
     }
@@ -898,9 +900,21 @@ class Recognizer::Impl {
     // are not smaller in real frames (bench/RESULTS.md, colour calibration). Matrices stored by `ecvpose colorcal`
     // keep the brightness already; this covers --no-keep-brightness and older libraries.
     const Eigen::Matrix3d to_scene = BrightnessPreserving(model.color_matrix->model_to_scene);
+    DescriptorOptions describe = library_.feature_settings().descriptor;
+    const bool surface_shape = describe.shape == DescriptorShape::kSurface;
+    describe.shape = DescriptorShape::kPrimitives;  // the surface context's half is kept: colours do not change it
     for (ModelView& view : record.views) {
       ApplyColorMatrix(to_scene, &view.primitives);
-      view.descriptors = ComputeDescriptors(view.primitives, library_.feature_settings().descriptor);
+      Descriptors recoloured = ComputeDescriptors(view.primitives, describe);
+      if (surface_shape) {
+        if (recoloured.primitive != view.descriptors.primitive) {
+          ThrowInputError("model " + model.record.name, "descriptors",
+                          "one row per primitive with a context, as the library's feature settings give");
+        }
+        const cv::Range shape(0, 3 * kDescriptorBins);
+        view.descriptors.values.colRange(shape).copyTo(recoloured.values.colRange(shape));
+      }
+      view.descriptors = std::move(recoloured);
     }
     return record;
   }
@@ -981,7 +995,7 @@ std::vector<Detection> DetectionsFromJson(const nlohmann::json& json, const std:
 }
 
 Descriptors ComputeSceneDescriptors(const std::vector<Primitive>& primitives, const DescriptorOptions& descriptor,
-                                    const RecognizerOptions& options) {
+                                    const RecognizerOptions& options, const SurfaceSamples* surface) {
   DescriptorOptions describe = descriptor;
   if (options.scene_max_neighbours > 0 &&
       (describe.max_neighbours == 0 || describe.max_neighbours > options.scene_max_neighbours)) {
@@ -989,7 +1003,7 @@ Descriptors ComputeSceneDescriptors(const std::vector<Primitive>& primitives, co
   }
   const size_t count = primitives.size(), most = static_cast<size_t>(options.scene_max_descriptors);
   const int source_step = most > 0 && count > most ? static_cast<int>((count + most - 1) / most) : 1;
-  return ComputeDescriptors(primitives, describe, options.ransac.threads, source_step);
+  return ComputeDescriptors(primitives, describe, options.ransac.threads, source_step, surface);
 }
 
 }  // namespace ecv

@@ -272,9 +272,10 @@ std::vector<Detection> DetectionsFromJson(const nlohmann::json& json, const std:
 
 /// A frame's descriptors as the recognizer computes them from its `primitives`: the library's `descriptor`
 /// settings with at most options.scene_max_neighbours neighbours per context, and every n-th primitive a source
-/// so that at most options.scene_max_descriptors are described; on options.ransac.threads threads.
+/// so that at most options.scene_max_descriptors are described; on options.ransac.threads threads. `surface`: the
+/// frame's surface, for a library whose descriptors use the surface context (DescriptorShape::kSurface).
 Descriptors ComputeSceneDescriptors(const std::vector<Primitive>& primitives, const DescriptorOptions& descriptor,
-                                    const RecognizerOptions& options);
+                                    const RecognizerOptions& options, const SurfaceSamples* surface = nullptr);
 
 /// What a tracking frame (Recognizer::Recognize with priors) searches for, by view ranking and RANSAC, besides
 /// following its priors.

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <vector>
 
+#include <opencv2/core.hpp>
+
 #include "core/error.h"
 
 namespace ecv {
@@ -57,6 +59,23 @@ DepthStats ComputeDepthStats(const cv::Mat& depth, const cv::Mat& mask) {
   std::nth_element(valid.begin(), valid.begin() + static_cast<long>(valid.size() / 2), valid.end());
   stats.median_m = valid[valid.size() / 2];
   return stats;
+}
+
+RgbdFrame TurnUpsideDown(const RgbdFrame& frame) {
+  RgbdFrame turned;
+  cv::rotate(frame.color, turned.color, cv::ROTATE_180);
+  cv::rotate(frame.depth, turned.depth, cv::ROTATE_180);
+  turned.camera = frame.camera;
+  turned.camera.cx = frame.camera.width - 1 - frame.camera.cx;
+  turned.camera.cy = frame.camera.height - 1 - frame.camera.cy;
+  turned.name = frame.name + " (turned 180 degrees)";
+  return turned;
+}
+
+Eigen::Isometry3d TurnedFromCamera() {
+  Eigen::Isometry3d turned = Eigen::Isometry3d::Identity();
+  turned.linear() = Eigen::Vector3d(-1.0, -1.0, 1.0).asDiagonal();
+  return turned;
 }
 
 std::vector<Eigen::Vector3f> DepthPoints(const RgbdFrame& frame, int stride) {

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
 #include "core/camera.h"
@@ -32,6 +33,15 @@ struct DepthStats {
 
 /// Statistics over the valid (> 0) pixels of a CV_32FC1 depth image, optionally only where `mask` != 0.
 DepthStats ComputeDepthStats(const cv::Mat& depth, const cv::Mat& mask = cv::Mat());
+
+/// The frame as the same camera rolled 180 degrees about its optical axis sees it: both images turned, the
+/// principal point mirrored (c' = size - 1 - c). A point p of the frame's camera is TurnedFromCamera() * p in the
+/// turned one, so a pose camera_from_object becomes TurnedFromCamera() * camera_from_object. Used to measure how
+/// recognition depends on how the camera is held (recognize_bench --turned).
+RgbdFrame TurnUpsideDown(const RgbdFrame& frame);
+
+/// diag(-1, -1, 1): the turned camera of TurnUpsideDown from the original one (its own inverse).
+Eigen::Isometry3d TurnedFromCamera();
 
 /// The frame's depth samples of every `stride`-th pixel in each direction (row by row), as camera-frame points.
 std::vector<Eigen::Vector3f> DepthPoints(const RgbdFrame& frame, int stride);

@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <memory>
 #include <numeric>
 #include <string>
 #include <thread>
 
 #include <flann/algorithms/dist.h>
 #include <flann/algorithms/kdtree_single_index.h>
+#include <Eigen/Eigenvalues>
 
 #include "core/error.h"
 
@@ -70,6 +72,7 @@ class ContextHistograms {
       : appearance_(appearance),
         options_(options),
         bins_(kDescriptorBins / options.shells),
+        first_histogram_(options.shape == DescriptorShape::kSurface ? 3 : 0),
         histograms_(options.use_color ? 6 : 3) {
     // Value k of a pair lies in [low_k, 1]; (value - low_k) * scale_k is its position in bins. Both factors
     // of the scale are powers of two, so this equals (value - low_k) / (1 - low_k) * bins exactly.
@@ -155,7 +158,7 @@ class ContextHistograms {
       }
     }
     float* shell = descriptor + shell_offset_[j];
-    for (int k = 0; k < histograms_; ++k) {
+    for (int k = first_histogram_; k < histograms_; ++k) {
       const float position = (values[k] - low_[k]) * scale_[k] - 0.5F;  // in bins, bin centres at integers
       float* histogram = shell + k * kDescriptorBins;
       if (options_.soft_binning) {  // shared linearly between the two nearest bins
@@ -183,13 +186,114 @@ class ContextHistograms {
 
   const AppearanceValues& appearance_;
   const DescriptorOptions& options_;
-  const int bins_;        // per histogram and radial shell
-  const int histograms_;  // filled: 6, or the 3 geometric ones without colour
-  float low_[6] = {};     // value k of a pair lies in [low_k, 1]
+  const int bins_;             // per histogram and radial shell
+  const int first_histogram_;  // 3 when the surface context fills the geometric ones (SurfaceHistograms)
+  const int histograms_;       // filled up to: 6, or the 3 geometric ones without colour
+  float low_[6] = {};          // value k of a pair lies in [low_k, 1]
   float scale_[6] = {};
   std::vector<Eigen::Vector3f> position_, orientation_, appearance_values_;  // of the gathered members
   std::vector<float> weight_;
   std::vector<int> shell_offset_;
+};
+
+// Radius searches whose members' order does not matter: FLANN would sort them by distance otherwise.
+flann::SearchParams Unsorted() {
+  flann::SearchParams params;
+  params.sorted = false;
+  return params;
+}
+
+// The surface context (DescriptorShape::kSurface) of a source: the first three histograms' 48 values.
+class SurfaceHistograms {
+ public:
+  static constexpr int kShells = 2, kSectors = 4, kBins = 3 * kDescriptorBins / (kShells * kSectors);
+
+  // `surface` must hold at least one sample and outlive this. FLANN's matrix takes a mutable pointer; the index only
+  // reads the points.
+  SurfaceHistograms(const SurfaceSamples& surface, const DescriptorOptions& options)
+      : surface_(surface),
+        radius_(static_cast<float>(options.radius_m)),
+        scale_(static_cast<float>(std::sqrt(3.0 * options.surface_weight))),
+        hellinger_(options.hellinger),
+        index_(flann::Matrix<float>(const_cast<float*>(surface.points[0].data()), surface.size(), 3),
+               flann::KDTreeSingleIndexParams(12)) {
+    index_.buildIndex();
+  }
+
+  // Fills values[0, 48) for the source at `source`; zeros when fewer than 5 samples lie within the radius.
+  void Describe(const Eigen::Vector3f& source, std::vector<std::vector<size_t>>& found,
+                std::vector<std::vector<float>>& squared, float* values) const {
+    constexpr int kValues = 3 * kDescriptorBins;
+    std::fill(values, values + kValues, 0.0F);
+    Eigen::Vector3f query = source;
+    index_.radiusSearch(flann::Matrix<float>(query.data(), 1, 3), found, squared, radius_ * radius_, Unsorted());
+    const std::vector<size_t>& members = found[0];
+    if (members.size() < 5) return;
+    Eigen::Vector3f x, y, z;
+    if (!ReferenceFrame(source, members, squared[0], &x, &y, &z)) return;
+    constexpr float kTwoPi = 6.28318531F;
+    for (size_t k = 0; k < members.size(); ++k) {
+      const Eigen::Vector3f offset = surface_.points[members[k]] - source;
+      const int shell = std::min(static_cast<int>(squared[0][k] / (radius_ * radius_) * kShells), kShells - 1);
+      // Shared linearly between the two nearest sectors (centres at k + 1/2 of kSectors around the circle).
+      const float azimuth = std::atan2(offset.dot(y), offset.dot(x)) + kTwoPi / 2.0F;  // [0, 2 pi]
+      const float centred = azimuth / kTwoPi * static_cast<float>(kSectors) - 0.5F;
+      const int low = static_cast<int>(std::floor(centred));
+      const float high_share = centred - static_cast<float>(low);
+      const int sectors[2] = {(low + kSectors) % kSectors, (low + 1) % kSectors};
+      const float sector_share[2] = {1.0F - high_share, high_share};
+      // The cosine of the sample's normal with z, shared between its two nearest bins.
+      const float cosine = std::clamp(surface_.normals[members[k]].dot(z), -1.0F, 1.0F);
+      const float position =
+          std::clamp((cosine + 1.0F) * 0.5F * static_cast<float>(kBins) - 0.5F, 0.0F, static_cast<float>(kBins - 1));
+      const int lower = std::min(static_cast<int>(position), kBins - 2);
+      const float upper = position - static_cast<float>(lower);
+      for (int t = 0; t < 2; ++t) {
+        float* histogram = values + (shell * kSectors + sectors[t]) * kBins;
+        histogram[lower] += sector_share[t] * (1.0F - upper);
+        histogram[lower + 1] += sector_share[t] * upper;
+      }
+    }
+    const float sum = std::accumulate(values, values + kValues, 0.0F);
+    if (sum <= 0.0F) return;
+    for (int k = 0; k < kValues; ++k) {
+      values[k] = hellinger_ ? scale_ * std::sqrt(values[k] / sum) : scale_ * values[k] / sum;
+    }
+  }
+
+ private:
+  // The source's local reference frame: eigenvectors of the covariance of the members' offsets, weighted by
+  // radius - distance. z (least variance) turned to the side most normals face, x (most variance) towards most
+  // of the offsets, y = z x x. Rigid: it moves with the surface. False when degenerate.
+  bool ReferenceFrame(const Eigen::Vector3f& source, const std::vector<size_t>& members,
+                      const std::vector<float>& squared, Eigen::Vector3f* x, Eigen::Vector3f* y,
+                      Eigen::Vector3f* z) const {
+    Eigen::Matrix3f covariance = Eigen::Matrix3f::Zero();
+    Eigen::Vector3f normal_sum = Eigen::Vector3f::Zero();
+    float total = 0.0F;
+    for (size_t k = 0; k < members.size(); ++k) {
+      const Eigen::Vector3f offset = surface_.points[members[k]] - source;
+      const float weight = radius_ - std::sqrt(squared[k]);
+      covariance += weight * offset * offset.transpose();
+      total += weight;
+      normal_sum += surface_.normals[members[k]];
+    }
+    if (!(total > 0.0F)) return false;
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3f> solver(covariance / total);
+    *z = solver.eigenvectors().col(0);
+    *x = solver.eigenvectors().col(2);
+    if (z->dot(normal_sum) < 0.0F) *z = -*z;
+    int ahead = 0;
+    for (const size_t m : members) ahead += (surface_.points[m] - source).dot(*x) >= 0.0F ? 1 : 0;
+    if (2 * ahead < static_cast<int>(members.size())) *x = -*x;
+    *y = z->cross(*x);
+    return true;
+  }
+
+  const SurfaceSamples& surface_;
+  const float radius_, scale_;
+  const bool hellinger_;
+  flann::KDTreeSingleIndex<flann::L2_Simple<float>> index_;
 };
 
 }  // namespace
@@ -199,6 +303,12 @@ DescriptorOptions DescriptorOptions::SourceShells() {
   options.pairs = DescriptorPairs::kSource;
   options.shells = 4;
   options.radius_m = 0.045;
+  return options;
+}
+
+DescriptorOptions DescriptorOptions::SurfaceShells() {
+  DescriptorOptions options = SourceShells();
+  options.shape = DescriptorShape::kSurface;
   return options;
 }
 
@@ -221,14 +331,35 @@ void DescriptorOptions::Check() const {
   if (shells != 1 && shells != 2 && shells != 4) {
     ThrowInputError("descriptor options", "shells", "1, 2 or 4", std::to_string(shells));
   }
+  if (shape != DescriptorShape::kPrimitives && shape != DescriptorShape::kSurface) {
+    ThrowInputError("descriptor options", "shape", "0 (the primitives' orientations) or 1 (the surface context)",
+                    std::to_string(static_cast<int>(shape)));
+  }
+  if (!(surface_weight > 0.0) || !std::isfinite(surface_weight)) {
+    ThrowInputError("descriptor options", "surface_weight", "a weight > 0", std::to_string(surface_weight));
+  }
   if (!(closeness_weight >= 0.0 && closeness_weight <= 1.0)) {
     ThrowInputError("descriptor options", "closeness_weight", "a weight in [0, 1]", std::to_string(closeness_weight));
   }
 }
 
+SurfaceSamples DescriptorSurface(const RgbdFrame& frame, const DescriptorOptions& options, const cv::Mat& mask) {
+  if (options.shape != DescriptorShape::kSurface) return {};
+  return SampleSurface(frame, mask);
+}
+
 Descriptors ComputeDescriptors(const std::vector<Primitive>& input, const DescriptorOptions& options, int threads,
-                               int source_step) {
+                               int source_step, const SurfaceSamples* surface) {
   options.Check();
+  const bool surface_shape = options.shape == DescriptorShape::kSurface;
+  if (surface_shape && surface == nullptr) {
+    ThrowInputError("descriptor computation", "surface",
+                    "the views' surface samples (the descriptor's shape is the surface context)");
+  }
+  if (surface != nullptr && surface->normals.size() != surface->points.size()) {
+    ThrowInputError("descriptor computation", "surface.normals", "one normal per point",
+                    std::to_string(surface->normals.size()) + " for " + std::to_string(surface->points.size()));
+  }
   if (threads < 1) ThrowInputError("descriptor computation", "threads", "at least 1", std::to_string(threads));
   if (source_step < 1) {
     ThrowInputError("descriptor computation", "source_step", "at least 1", std::to_string(source_step));
@@ -255,6 +386,8 @@ Descriptors ComputeDescriptors(const std::vector<Primitive>& input, const Descri
   const size_t sources = (primitives.size() + step - 1) / step;
 
   const AppearanceValues appearance = ComputeAppearance(primitives, options.appearance);
+  std::unique_ptr<SurfaceHistograms> surface_histograms;
+  if (surface_shape && surface->size() > 0) surface_histograms = std::make_unique<SurfaceHistograms>(*surface, options);
   // Row s describes source s (primitive s * step); the rows of isolated sources are dropped at the end. Each
   // worker searches its own sources' neighbours: on a dense frame the radius searches are a large share of the work.
   cv::Mat values(static_cast<int>(sources), kDescriptorSize, CV_32F);
@@ -280,8 +413,15 @@ Descriptors ComputeDescriptors(const std::vector<Primitive>& input, const Descri
         neighbours.push_back(static_cast<int>(near[k]));
         neighbour_distances.push_back(std::sqrt(found_squared[0][k]));
       }
-      histograms.Describe(primitives, static_cast<int>(s * step), neighbours, neighbour_distances,
-                          values.ptr<float>(static_cast<int>(s)));
+      float* row = values.ptr<float>(static_cast<int>(s));
+      histograms.Describe(primitives, static_cast<int>(s * step), neighbours, neighbour_distances, row);
+      if (surface_shape) {
+        if (surface_histograms) {
+          surface_histograms->Describe(primitives[s * step].position, found, found_squared, row);
+        } else {
+          std::fill(row, row + 3 * kDescriptorBins, 0.0F);
+        }
+      }
       described[s] = 1;
     }
   };

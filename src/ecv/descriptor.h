@@ -5,6 +5,7 @@
 #include <opencv2/core.hpp>
 
 #include "ecv/primitives.h"
+#include "ecv/surface_shape.h"
 
 namespace ecv {
 
@@ -30,6 +31,18 @@ enum class DescriptorAppearance : int {
   kMonogenic = 2,
 };
 
+/// Where the three shape histograms come from. Stored in libraries as its integer value.
+enum class DescriptorShape : int {
+  /// R_G1..3: cosines of the primitives' orientations and offsets within the context (the paper).
+  kPrimitives = 0,
+  /// The surface context, a hybrid beyond the paper: the depth image's surface (SurfaceSamples) within the radius,
+  /// in the source's local reference frame (the axes of the surface's covariance, z along its normal, x towards most
+  /// of the surface, as SHOT's), split into 2 radial shells x 4 azimuthal sectors; each region holds a 6-bin
+  /// histogram of the cosine of the samples' normals with z. It needs no primitive's orientation, so it does not
+  /// change with the camera's roll, and the dense surface gives a steadier frame than the sparse primitives.
+  kSurface = 1,
+};
+
 /// The ECV context descriptor (paper Sect. II-B; DESIGN.md "Context descriptor"). Defaults chosen by the
 /// correspondence score on YCB-Video videos 0000 and 0001 (bench/RESULTS.md, ablations); the paper's own
 /// descriptor is soft_binning = false, hellinger = false with the pairs, appearance and weighting below at
@@ -43,9 +56,15 @@ struct DescriptorOptions {
   /// over their distance ranks so that the context still spans the radius; 0 = all, as in the paper.
   /// Pairs grow with its square: the cap bounds the cost in dense views.
   int max_neighbours = 0;
-  bool unsigned_segments = false;  ///< a segment's direction has no sign: use |cosines| that involve one
-  bool soft_binning = true;        ///< share each value between its two nearest bins (linear)
-  bool use_color = true;           ///< false: shape only (the three colour histograms stay zero)
+  /// A segment's direction has no sign: use |cosines| that involve one. A segment's sign follows the image axes
+  /// (Primitive::orientation), so signed directions change with the camera's roll about its optical axis and
+  /// unsigned ones do not. Libraries use signed ones: upright / turned 180 degrees, the 30 YCB-Video frames give
+  /// 182 / 145 of 210 objects signed, 171 / 174 unsigned, but unsigned lose the LM-O can (found with 1 of 6 seeds
+  /// instead of 6); build with {"descriptor": {"unsigned_segments": true}} for a camera not held level
+  /// (bench/RESULTS.md, session 32).
+  bool unsigned_segments = false;
+  bool soft_binning = true;  ///< share each value between its two nearest bins (linear)
+  bool use_color = true;     ///< false: shape only (the three colour histograms stay zero)
   /// Grey-world balance before the colour differences: each channel scaled so that the mean over the
   /// primitives is 0.5 (beyond the paper: cancels white balance and exposure between views).
   bool balance_colors = false;
@@ -68,6 +87,10 @@ struct DescriptorOptions {
   /// The largest gain measured: with source pairs at 3.5 cm, 1 / 2 / 4 shells give 12.4 / 18.2 / 20.1 %
   /// on recognition tuning.
   int shells = 1;
+  /// The shape histograms (see the enum). kSurface needs the views' SurfaceSamples in ComputeDescriptors.
+  DescriptorShape shape = DescriptorShape::kPrimitives;
+  /// kSurface: squared length of the shape half against the three colour histograms' (3 with Hellinger).
+  double surface_weight = 2.0;
 
   /// The context model libraries are built with (FeatureSettings): pairs of the source with each neighbour
   /// (kSource) in 4 radial shells over 4.5 cm. discriminative_bench (bench/RESULTS.md, 2026-11-22 06:12), mean
@@ -76,6 +99,8 @@ struct DescriptorOptions {
   /// End to end on the 30 YCB-Video frames (RANSAC seeds 1/2/3) with the recognizer's surface-fit factor:
   /// 57 / 55 / 57 of 70 objects against 49 / 47 / 46 (bench/RESULTS.md, session 15).
   static DescriptorOptions SourceShells();
+  /// SourceShells() with the surface context for its shape histograms (DescriptorShape::kSurface).
+  static DescriptorOptions SurfaceShells();
 
   void Check() const;
 };
@@ -94,8 +119,14 @@ struct Descriptors {
 /// the context.
 /// `threads` worker threads share the primitives out; the result does not depend on their number. With
 /// `source_step` n > 1 only every n-th primitive (0, n, 2n, ...) is a source and gets a descriptor, the same
-/// one it gets with n = 1; every primitive still belongs to the contexts.
+/// one it gets with n = 1; every primitive still belongs to the contexts. With DescriptorShape::kSurface the
+/// first three histograms are the surface context over `surface` (in the primitives' frame; InputError when
+/// null).
+/// The support a frame's descriptors need under `options`: its surface where `mask` (CV_8UC1, optional) is set;
+/// empty unless the shape is DescriptorShape::kSurface.
+SurfaceSamples DescriptorSurface(const RgbdFrame& frame, const DescriptorOptions& options, const cv::Mat& mask = {});
+
 Descriptors ComputeDescriptors(const std::vector<Primitive>& primitives, const DescriptorOptions& options = {},
-                               int threads = 1, int source_step = 1);
+                               int threads = 1, int source_step = 1, const SurfaceSamples* surface = nullptr);
 
 }  // namespace ecv

@@ -19,8 +19,9 @@ const char* ToString(PrimitiveType type);
 struct Primitive {
   PrimitiveType type = PrimitiveType::kTexlet;
   Eigen::Vector3f position = Eigen::Vector3f::Zero();  ///< metres
-  /// Unit vector: a segment's 3D direction along its edge (its sign carries no meaning), a texlet's surface
-  /// normal facing the camera.
+  /// Unit vector: a segment's 3D direction along its edge, a texlet's surface normal facing the camera. A
+  /// segment's sign follows the image axes (the monogenic orientation lies in [0, pi)), not the object: it
+  /// turns over when the camera rolls about its optical axis (DescriptorOptions::unsigned_segments).
   Eigen::Vector3f orientation = Eigen::Vector3f::UnitZ();
   Eigen::Vector3f color = Eigen::Vector3f::Zero();  ///< mean RGB near the keypoint, in [0, 1]
   Eigen::Vector2f pixel = Eigen::Vector2f::Zero();  ///< keypoint, pixels

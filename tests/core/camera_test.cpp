@@ -5,6 +5,7 @@
 
 #include "core/camera.h"
 #include "core/error.h"
+#include "core/frame.h"
 
 namespace ecv {
 namespace {
@@ -90,6 +91,47 @@ TEST(FitPinholeCamera, RejectsCloudsWithoutEnoughPoints) {
   EXPECT_THROW(FitPinholeCamera(points), InputError);
   points.setTo(cv::Scalar(0.0, 0.0, 1.0));  // all on the axis: no spread to fit a focal length
   EXPECT_THROW(FitPinholeCamera(points), InputError);
+}
+
+// A frame whose pixels all differ: colour (u, v, u + v) and depth 1 + u / 1000 + v / 100000 metres.
+RgbdFrame GradientFrame() {
+  RgbdFrame frame;
+  frame.camera = kYcbvCamera;
+  frame.color.create(kYcbvCamera.height, kYcbvCamera.width, CV_8UC3);
+  frame.depth.create(kYcbvCamera.height, kYcbvCamera.width, CV_32FC1);
+  for (int v = 0; v < frame.depth.rows; ++v) {
+    for (int u = 0; u < frame.depth.cols; ++u) {
+      frame.color.at<cv::Vec3b>(v, u) =
+          cv::Vec3b(static_cast<uchar>(u), static_cast<uchar>(v), static_cast<uchar>(u + v));
+      frame.depth.at<float>(v, u) = 1.0F + static_cast<float>(u) / 1e3F + static_cast<float>(v) / 1e5F;
+    }
+  }
+  return frame;
+}
+
+// Each pixel's 3D point, seen by the turned camera, is the original point moved by TurnedFromCamera(), with the same
+// colour; turning twice gives the frame back.
+TEST(TurnUpsideDown, SeesEveryPointWhereTheRolledCameraSeesIt) {
+  const RgbdFrame frame = GradientFrame();
+  const RgbdFrame turned = TurnUpsideDown(frame);
+  turned.Check();
+  for (const cv::Point pixel : {cv::Point(0, 0), cv::Point(639, 479), cv::Point(100, 300), cv::Point(313, 241)}) {
+    const Eigen::Vector3d point =
+        frame.camera.BackProject(Eigen::Vector2d(pixel.x, pixel.y), frame.depth.at<float>(pixel));
+    const Eigen::Vector3d moved = TurnedFromCamera() * point;
+    const Eigen::Vector2d seen = turned.camera.Project(moved);
+    const cv::Point turned_pixel(static_cast<int>(std::lround(seen.x())), static_cast<int>(std::lround(seen.y())));
+    EXPECT_LT((seen - Eigen::Vector2d(turned_pixel.x, turned_pixel.y)).norm(), 1e-9) << pixel;
+    EXPECT_EQ(turned_pixel, cv::Point(639 - pixel.x, 479 - pixel.y));
+    EXPECT_FLOAT_EQ(turned.depth.at<float>(turned_pixel), static_cast<float>(moved.z()));
+    EXPECT_EQ(turned.color.at<cv::Vec3b>(turned_pixel), frame.color.at<cv::Vec3b>(pixel));
+  }
+  const RgbdFrame back = TurnUpsideDown(turned);
+  EXPECT_EQ(cv::norm(back.color, frame.color, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(back.depth, frame.depth, cv::NORM_INF), 0.0);
+  EXPECT_DOUBLE_EQ(back.camera.cx, frame.camera.cx);
+  EXPECT_DOUBLE_EQ(back.camera.cy, frame.camera.cy);
+  EXPECT_TRUE((TurnedFromCamera() * TurnedFromCamera()).isApprox(Eigen::Isometry3d::Identity()));
 }
 
 }  // namespace

@@ -294,6 +294,88 @@ TEST(EcvDescriptor, SegmentSignMattersOnlyWhenSigned) {
   EXPECT_GT(cv::norm(ComputeDescriptors(primitives).values, ComputeDescriptors(flipped).values, cv::NORM_L1), 1.0);
 }
 
+// A square of surface samples on the plane z = 0.8 (camera frame), 2 mm apart, normals facing the camera.
+SurfaceSamples PlaneSurface() {
+  SurfaceSamples surface;
+  for (int i = -40; i <= 40; ++i) {
+    for (int j = -40; j <= 40; ++j) {
+      surface.points.emplace_back(0.002F * static_cast<float>(i), 0.002F * static_cast<float>(j), 0.8F);
+      surface.normals.emplace_back(0.0F, 0.0F, -1.0F);
+    }
+  }
+  return surface;
+}
+
+// On a plane every sample's normal is the local normal: each of the 2 x 4 regions' 6-bin histograms has all of its
+// weight in the last bin (cosine 1), and the shape half, as square roots, has the squared length 3 x surface_weight.
+TEST(SurfaceContext, APlaneFillsTheLastCosineBinOfEveryRegion) {
+  std::vector<Primitive> primitives = RandomPrimitives(60, 9);
+  for (Primitive& p : primitives) p.position = Eigen::Vector3f(p.position.x() - 0.06F, p.position.y() - 0.06F, 0.8F);
+  const SurfaceSamples plane = PlaneSurface();
+  DescriptorOptions options = DescriptorOptions::SurfaceShells();
+  options.surface_weight = 1.5;
+  const Descriptors descriptors = ComputeDescriptors(primitives, options, 1, 1, &plane);
+  ASSERT_GT(descriptors.values.rows, 50);
+  constexpr int kBins = 6;
+  for (int row = 0; row < descriptors.values.rows; ++row) {
+    const float* values = descriptors.values.ptr<float>(row);
+    float squared = 0.0F;
+    for (int k = 0; k < 3 * kDescriptorBins; ++k) {
+      squared += values[k] * values[k];
+      if (k % kBins != kBins - 1) {
+        ASSERT_EQ(values[k], 0.0F) << "row " << row << " value " << k;
+      }
+    }
+    EXPECT_NEAR(squared, 3.0 * 1.5, 1e-4) << "row " << row;
+  }
+}
+
+// The surface context on a real frame: the primitives and the surface moved together give the same descriptors,
+// the colour histograms still sum to 1, and the primitives' orientations play no part, so a segment's sign (which
+// follows the camera's roll) cannot change them.
+TEST(SurfaceContext, InvariantToRigidMotionAndBlindToSegmentSigns) {
+  const LoadedFrame frame = LoadYcbvFrame(test::DataPath("ycbv_subset/Example-Scenes/0001/000001"));
+  const std::vector<Primitive> primitives = ExtractPrimitives(frame.rgbd).primitives;
+  const SurfaceSamples surface = SampleSurface(frame.rgbd);
+  ASSERT_GT(surface.size(), 5000U);
+  const DescriptorOptions options = DescriptorOptions::SurfaceShells();
+  const Descriptors original = ComputeDescriptors(primitives, options, 2, 7, &surface);
+  ASSERT_GT(original.values.rows, 500);
+
+  const Eigen::Isometry3d motion = SomeRigidMotion();
+  const SurfaceSamples moved_surface = MovedSurface(surface, motion.cast<float>());
+  const Descriptors moved = ComputeDescriptors(Moved(primitives, motion), options, 2, 7, &moved_surface);
+  ASSERT_EQ(original.primitive, moved.primitive);
+  // A row changes only where a sample sits on a region's edge to float precision, or where the surface is so
+  // symmetric about the source that its frame's x axis is not defined.
+  int same = 0;
+  for (int row = 0; row < original.values.rows; ++row) {
+    same += cv::norm(original.values.row(row), moved.values.row(row), cv::NORM_L1) < 1e-2 ? 1 : 0;
+    for (int h = 3; h < 6; ++h) {
+      const cv::Mat histogram = original.values.row(row).colRange(h * kDescriptorBins, (h + 1) * kDescriptorBins);
+      ASSERT_NEAR(histogram.dot(histogram), 1.0, 1e-5) << "row " << row << " histogram " << h;
+    }
+  }
+  EXPECT_GT(same, original.values.rows * 98 / 100);
+
+  std::vector<Primitive> flipped = primitives;
+  for (Primitive& p : flipped) p.orientation = -p.orientation;
+  EXPECT_EQ(cv::norm(original.values, ComputeDescriptors(flipped, options, 2, 7, &surface).values, cv::NORM_L1), 0.0);
+}
+
+TEST(SurfaceContext, NeedsTheSurface) {
+  const std::vector<Primitive> primitives = RandomPrimitives(50, 4);
+  const DescriptorOptions options = DescriptorOptions::SurfaceShells();
+  EXPECT_THROW(ComputeDescriptors(primitives, options), InputError);
+  SurfaceSamples broken = PlaneSurface();
+  broken.normals.pop_back();
+  EXPECT_THROW(ComputeDescriptors(primitives, options, 1, 1, &broken), InputError);
+  DescriptorOptions weightless = options;
+  weightless.surface_weight = 0.0;
+  const SurfaceSamples plane = PlaneSurface();
+  EXPECT_THROW(ComputeDescriptors(primitives, weightless, 1, 1, &plane), InputError);
+}
+
 // The paper's definition written out pair by pair, with the defaults' soft bins and square roots: the
 // neighbours within the radius by distance to the source, every pair {a, b} with a the closer, three cosines
 // and three colour differences, each shared linearly between its two nearest of 16 bins over [-1, 1].
@@ -389,15 +471,21 @@ TEST(EcvMatching, FindsTheMovedCopyOfEachPrimitive) {
 TEST(EcvMatching, RealViewAgainstItselfScoresOne) {
   const LoadedFrame frame = LoadYcbvFrame(test::DataPath("ycbv_subset/Example-Scenes/0000/000001"));
   const std::vector<Primitive> primitives = ExtractPrimitives(frame.rgbd).primitives;
-  const Descriptors descriptors = ComputeDescriptors(primitives);
-  ASSERT_GT(descriptors.primitive.size(), 1000U);
-  const DescriptorMatcher matcher(primitives, descriptors);  // approximate: more than exact_below rows
-  const CorrespondenceScore score = ScoreCorrespondences(primitives, primitives, matcher.Match(primitives, descriptors),
-                                                         Eigen::Isometry3d::Identity());
-  EXPECT_EQ(score.hypotheses, static_cast<int>(descriptors.primitive.size()));
-  EXPECT_GT(score.Score(), 0.99);
-  EXPECT_NEAR(TruePartnerFraction(primitives, descriptors.primitive, primitives, Eigen::Isometry3d::Identity()), 1.0,
-              1e-12);
+  const SurfaceSamples surface = SampleSurface(frame.rgbd);
+  for (const bool surface_context : {false, true}) {
+    SCOPED_TRACE(surface_context ? "surface context" : "field defaults");
+    const Descriptors descriptors =
+        surface_context ? ComputeDescriptors(primitives, DescriptorOptions::SurfaceShells(), 2, 1, &surface)
+                        : ComputeDescriptors(primitives);
+    ASSERT_GT(descriptors.primitive.size(), 1000U);
+    const DescriptorMatcher matcher(primitives, descriptors);  // approximate: more than exact_below rows
+    const CorrespondenceScore score = ScoreCorrespondences(
+        primitives, primitives, matcher.Match(primitives, descriptors), Eigen::Isometry3d::Identity());
+    EXPECT_EQ(score.hypotheses, static_cast<int>(descriptors.primitive.size()));
+    EXPECT_GT(score.Score(), 0.99);
+    EXPECT_NEAR(TruePartnerFraction(primitives, descriptors.primitive, primitives, Eigen::Isometry3d::Identity()), 1.0,
+                1e-12);
+  }
 }
 
 // The recognizer matches a view's ranking subset first and the other rows later, and needs the merged matches

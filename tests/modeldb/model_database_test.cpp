@@ -185,6 +185,16 @@ TEST(ModelDatabase, ReadsSettingsStoredWithoutTheNewerDescriptorFieldsAsTheyWere
   EXPECT_EQ(partial.descriptor.pairs, DescriptorPairs::kSource);
   EXPECT_EQ(partial.descriptor.shells, 4);
   EXPECT_EQ(partial.descriptor.radius_m, 0.045);
+  EXPECT_EQ(partial.descriptor.shape, DescriptorShape::kPrimitives);
+
+  // The surface context's settings, read and written back.
+  const FeatureSettings surface =
+      FeatureSettingsFromJson(R"({"descriptor": {"shape": 1, "surface_weight": 3.5}})", "test");
+  EXPECT_EQ(surface.descriptor.shape, DescriptorShape::kSurface);
+  EXPECT_EQ(surface.descriptor.surface_weight, 3.5);
+  const FeatureSettings again = FeatureSettingsFromJson(FeatureSettingsToJson(surface), "test");
+  EXPECT_EQ(again.descriptor.shape, DescriptorShape::kSurface);
+  EXPECT_EQ(again.descriptor.surface_weight, 3.5);
 }
 
 TEST(ModelDatabase, RefusesIncompleteRecords) {
