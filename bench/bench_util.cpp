@@ -3,6 +3,8 @@
 #include <sched.h>
 #include <sys/wait.h>
 
+#include <CLI/CLI.hpp>
+
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -10,12 +12,22 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <numeric>
 
 namespace ecv::bench {
 
-double MillisecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+std::optional<int> ParseCommandLine(CLI::App& app, int argc, char** argv) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& error) {
+    return app.exit(error) == 0 ? 0 : 2;  // prints the help or the usage error
+  }
+  return std::nullopt;
+}
+
+CLI::Validator AtLeastOne() {
+  return CLI::Range(1, std::numeric_limits<int>::max()).description("POSITIVE");
 }
 
 std::string MachineDescription() {

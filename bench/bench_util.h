@@ -1,17 +1,24 @@
 #pragma once
 
-#include <chrono>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "io/frame_io.h"
 
+namespace CLI {
+class App;
+class Validator;
+}  // namespace CLI
+
 namespace ecv::bench {
 
-using Clock = std::chrono::steady_clock;
+/// Parses the command line into `app`'s options (CLI11). Returns nothing when the bench should go on, else the
+/// exit code: 0 after --help (the help printed), 2 after bad usage (CLI11's message on stderr).
+std::optional<int> ParseCommandLine(CLI::App& app, int argc, char** argv);
 
-/// Milliseconds since `start`.
-double MillisecondsSince(Clock::time_point start);
+/// Check of a count flag (runs, frames, seeds, threads): a whole number of at least 1.
+CLI::Validator AtLeastOne();
 
 /// "Intel(R) Xeon(R) ... (2 cores)" from /proc/cpuinfo and the scheduler.
 std::string MachineDescription();

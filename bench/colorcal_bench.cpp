@@ -10,9 +10,10 @@
 //
 //   colorcal_bench [--trials N] [--data DIR] [--results FILE] [--no-report] [--effect] [--library-distance M]
 
+#include <CLI/CLI.hpp>
+
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <fstream>
 #include <iostream>
 #include <limits>
@@ -27,6 +28,7 @@
 #include "colorcal/color_pairs.h"
 #include "colorcal/pairs_csv.h"
 #include "core/error.h"
+#include "core/timing.h"
 #include "discriminative_data.h"
 #include "ecv/matching.h"
 #include "io/frame_io.h"
@@ -35,7 +37,8 @@
 
 namespace {
 
-using ecv::bench::Clock;
+using ecv::Clock;
+using ecv::MillisecondsSince;
 using ecv::bench::Fixed;
 
 const char* const kVideos[] = {"0000", "0001", "0002"};
@@ -138,7 +141,7 @@ std::string SyntheticTable(const Settings& settings) {
           } catch (const ecv::InputError&) {  // fewer than 3 inliers: a failure
             errors.push_back(std::numeric_limits<double>::infinity());
           }
-          times.push_back(ecv::bench::MillisecondsSince(start));
+          times.push_back(MillisecondsSince(start));
           good += errors.back() < 0.08;
         }
         table << ' ' << Fixed(100.0 * good / settings.trials, 0) << " % / " << Fixed(ecv::bench::Median(errors), 3)
@@ -302,7 +305,7 @@ std::string MethodTable(const std::vector<FramePairs>& frames) {
     for (const auto& [label, options] : Methods()) {
       const auto start = Clock::now();
       const std::string after = After(fit, test, options);
-      table << ' ' << after << " (" << Fixed(ecv::bench::MillisecondsSince(start), 0) << " ms) |";
+      table << ' ' << after << " (" << Fixed(MillisecondsSince(start), 0) << " ms) |";
     }
     table << '\n';
   }
@@ -663,26 +666,23 @@ std::string EffectReport(const Settings& settings) {
 
 int main(int argc, char** argv) {
   Settings settings;
-  for (int i = 1; i < argc; ++i) {
-    const std::string flag = argv[i];
-    if (flag == "--trials" && i + 1 < argc) {
-      settings.trials = std::stoi(argv[++i]);
-    } else if (flag == "--data" && i + 1 < argc) {
-      settings.data = argv[++i];
-    } else if (flag == "--results" && i + 1 < argc) {
-      settings.results = argv[++i];
-    } else if (flag == "--no-report") {
-      settings.report = false;
-    } else if (flag == "--effect") {
-      settings.effect = true;
-    } else if (flag == "--library-distance" && i + 1 < argc) {
-      settings.library_distance_m = std::stod(argv[++i]);
-    } else {
-      std::cerr << "usage: colorcal_bench [--trials N] [--data DIR] [--results FILE] [--no-report] [--effect] "
-                   "[--library-distance M]\n";
-      return 2;
-    }
-  }
+  CLI::App app{
+      "colorcal_bench: the colour-matrix fit, on synthetic pairs and real YCB-Video frames; with --effect, "
+      "the hand-labelled pairs and the fitted matrices' effect on colour errors and matching.",
+      "colorcal_bench"};
+  app.add_option("--trials", settings.trials, "Seeded synthetic fits per cell (pair count, mislabelled share, method)")
+      ->capture_default_str();
+  app.add_option("--data", settings.data, "Data directory (with ycbv_subset)")->capture_default_str();
+  app.add_option("--results", settings.results, "Markdown file the report is appended to")->capture_default_str();
+  app.add_flag_callback(
+      "--no-report", [&settings] { settings.report = false; }, "Print the tables only: append nothing to --results");
+  app.add_flag("--effect", settings.effect,
+               "Instead of the synthetic and real fits: the hand-labelled pairs and the fitted matrices' effect on "
+               "held-out frames");
+  app.add_option("--library-distance", settings.library_distance_m,
+                 "With --effect: distance in metres of the library views matched against the frames")
+      ->capture_default_str();
+  if (const auto exit_code = ecv::bench::ParseCommandLine(app, argc, argv)) return *exit_code;
   try {
     if (settings.effect) {
       const std::string markdown = EffectReport(settings);

@@ -7,9 +7,10 @@
 //   discriminative_bench [--results FILE] [--figures DIR] [--ablations-only] [--variants TEXT]
 //                        [--library-distance M] [--headlight]
 
+#include <CLI/CLI.hpp>
+
 #include <algorithm>
 #include <cstdlib>
-#include <cstring>
 #include <filesystem>
 #include <functional>
 #include <iostream>
@@ -25,6 +26,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "bench_util.h"
+#include "core/timing.h"
 #include "discriminative_data.h"
 #include "ecv/matching.h"
 #include "io/frame_io.h"
@@ -538,14 +540,23 @@ int main(int argc, char** argv) {
   std::string variant_filter;     // only ablation variants whose name contains one of its '|'-separated parts
   double library_distance_m = 0;  // 0: library views as close as the object fits the image
   ecv::Shading shading = ecv::Shading::kUnlit;  // of the library renders
-  for (int i = 1; i < argc; ++i) {
-    if (std::strcmp(argv[i], "--ablations-only") == 0) ablations_only = true;
-    if (i + 1 < argc && std::strcmp(argv[i], "--results") == 0) results = argv[i + 1];
-    if (i + 1 < argc && std::strcmp(argv[i], "--figures") == 0) figures = argv[i + 1];
-    if (i + 1 < argc && std::strcmp(argv[i], "--variants") == 0) variant_filter = argv[i + 1];
-    if (i + 1 < argc && std::strcmp(argv[i], "--library-distance") == 0) library_distance_m = std::atof(argv[i + 1]);
-    if (std::strcmp(argv[i], "--headlight") == 0) shading = ecv::Shading::kHeadlight;
-  }
+  CLI::App app{
+      "discriminative_bench: correspondence score of the ECV context descriptor and its peers on real view "
+      "pairs with known relative pose (paper Fig. 7), and the descriptor's ablations.",
+      "discriminative_bench"};
+  app.add_option("--results", results, "Markdown file the report is appended to")->capture_default_str();
+  app.add_option("--figures", figures, "Directory the bar chart and the picture of matches are written to")
+      ->capture_default_str();
+  app.add_flag("--ablations-only", ablations_only, "Only the ablation table: no peers, no figures");
+  app.add_option("--variants", variant_filter,
+                 "Only the ablation variants whose name contains one of these '|'-separated parts (default: all)");
+  app.add_option("--library-distance", library_distance_m,
+                 "Distance in metres of the library views from the object (0: as close as the object fits the image)")
+      ->capture_default_str();
+  app.add_flag_callback(
+      "--headlight", [&shading] { shading = ecv::Shading::kHeadlight; },
+      "Render the library views with headlight shading (default: unlit)");
+  if (const auto exit_code = ParseCommandLine(app, argc, argv)) return *exit_code;
   std::cerr << "rendering and loading view pairs...\n";
   const std::vector<ecv::bench::ViewPair> pairs = LoadViewPairs(ECV_DATA_DIR, library_distance_m, shading);
   const auto methods = Methods();

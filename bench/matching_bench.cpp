@@ -7,6 +7,8 @@
 //   scripts/build_ycbv_library /tmp/ycbv.sqlite --views 40 --distance 0.9
 //   matching_bench --db /tmp/ycbv.sqlite [--frames N] [--results bench/RESULTS.md]
 
+#include <CLI/CLI.hpp>
+
 #include <algorithm>
 #include <iostream>
 #include <numeric>
@@ -17,6 +19,7 @@
 
 #include "bench_util.h"
 #include "core/byte_neighbours.h"
+#include "core/timing.h"
 #include "ecv/matching.h"
 #include "ecv/primitives.h"
 #include "modeldb/model_library.h"
@@ -188,33 +191,6 @@ struct Settings {
   std::string results = std::string(ECV_SOURCE_DIR) + "/bench/RESULTS.md";
 };
 
-// Throws std::invalid_argument naming the flag that is unknown, lacks its value or has a bad one.
-Settings ParseArguments(int argc, char** argv) {
-  Settings settings;
-  for (int i = 1; i < argc; ++i) {
-    const std::string flag = argv[i];
-    if (flag != "--db" && flag != "--frames" && flag != "--results")
-      throw std::invalid_argument("unknown flag " + flag);
-    if (i + 1 >= argc) throw std::invalid_argument(flag + " needs a value");
-    const std::string value = argv[++i];
-    if (flag == "--db") settings.db = value;
-    if (flag == "--results") settings.results = value;
-    if (flag == "--frames") {
-      std::size_t used = 0;
-      try {
-        settings.frames = std::stoi(value, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used != value.size() || settings.frames < 1) {
-        throw std::invalid_argument("--frames expects a positive integer, got '" + value + "'");
-      }
-    }
-  }
-  if (settings.db.empty()) throw std::invalid_argument("--db is required");
-  return settings;
-}
-
 std::string Run(const Settings& settings) {
   const ModelLibrary library = ModelLibrary::Load(settings.db);
   const auto [query, queries] = RankingQueries(library);
@@ -250,13 +226,18 @@ std::string Run(const Settings& settings) {
 
 int main(int argc, char** argv) {
   ecv::bench::Settings settings;
-  try {
-    settings = ecv::bench::ParseArguments(argc, argv);
-  } catch (const std::invalid_argument& error) {
-    std::cerr << "matching_bench: " << error.what()
-              << "\nusage: matching_bench --db LIBRARY.sqlite [--frames N] [--results FILE]\n";
-    return 2;
-  }
+  CLI::App app{
+      "matching_bench: descriptor matching as the recognizer does it, library views into a real frame: "
+      "ecvpose's KdForest and ByteNeighbours against OpenCV's FLANN and brute force (time, exact "
+      "neighbours found).",
+      "matching_bench"};
+  app.add_option("--db", settings.db, "Model library whose views are matched")->required();
+  app.add_option("--frames", settings.frames, "YCB-Video frames, spread over the three videos")
+      ->check(ecv::bench::AtLeastOne())
+      ->capture_default_str();
+  app.add_option("--results", settings.results, "Markdown file the report is appended to")->capture_default_str();
+  app.footer("Library:\n  scripts/build_ycbv_library /tmp/ycbv.sqlite --views 40 --distance 0.9");
+  if (const auto exit_code = ecv::bench::ParseCommandLine(app, argc, argv)) return *exit_code;
   try {
     const std::string table = ecv::bench::Run(settings);
     ecv::bench::Report(settings.results, "Descriptor matching: KdForest and FLANN (matching_bench)",

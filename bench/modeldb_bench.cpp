@@ -8,10 +8,12 @@
 //  Peer: the same records read from a flat binary file (no SQL, no index) in the same run.
 // Appends a section to bench/RESULTS.md (bench_util Report).
 //
-//   modeldb_bench [--views N] [--fit-views N] [--scale-views N] [--study-views N] [--data DIR] [--work DIR]
-//                 [--results FILE]
+//   modeldb_bench [--views N] [--fit-views N] [--scale-views N] [--study-views N] [--scales N,N,...] [--data DIR]
+//                 [--work DIR] [--results FILE]
 
 #include <sys/stat.h>
+
+#include <CLI/CLI.hpp>
 
 #include <cmath>
 #include <cstdio>
@@ -19,11 +21,11 @@
 #include <fstream>
 #include <iostream>
 #include <random>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "bench_util.h"
+#include "core/timing.h"
 #include "ecv/matching.h"
 #include "io/frame_io.h"
 #include "io/mesh_io.h"
@@ -33,9 +35,9 @@
 
 namespace {
 
-using ecv::bench::Clock;
+using ecv::Clock;
+using ecv::MillisecondsSince;
 using ecv::bench::Fixed;
-constexpr auto Milliseconds = ecv::bench::MillisecondsSince;
 namespace fs = std::filesystem;
 
 const char* const kObjects[] = {"003_cracker_box",    "004_sugar_box",   "005_tomato_soup_can",
@@ -332,28 +334,28 @@ std::string ScalingRow(const Settings& settings, const ScalingMeshes& meshes, in
   const std::string path = settings.work + "/scale_" + std::to_string(count) + ".sqlite";
   auto start = Clock::now();
   SynthesiseLibrary(meshes, count, settings.scale_views, path, renderer);
-  const double build_ms = Milliseconds(start);
+  const double build_ms = MillisecondsSince(start);
   start = Clock::now();
   const ecv::ModelLibrary library = ecv::ModelLibrary::Load(path);
-  const double load_ms = Milliseconds(start);
+  const double load_ms = MillisecondsSince(start);
   start = Clock::now();
   size_t matches = 0;
   for (const ecv::LibraryModel& model : library.models()) {
     for (const auto& matcher : model.matchers) matches += matcher->Match(scene.primitives, scene.descriptors).size();
   }
-  const double query_ms = Milliseconds(start);
+  const double query_ms = MillisecondsSince(start);
   ecv::LibraryLoadOptions one_index;
   one_index.build_matchers = false;
   one_index.build_library_index = true;
   const ecv::ModelLibrary indexed = ecv::ModelLibrary::Load(path, one_index);
   start = Clock::now();
   const size_t library_matches = indexed.MatchLibrary(scene.primitives, scene.descriptors).size();
-  const double library_query_ms = Milliseconds(start);
+  const double library_query_ms = MillisecondsSince(start);
   const std::string flat = settings.work + "/scale_" + std::to_string(count) + ".bin";
   WriteFlat(flat, ecv::ModelDatabase(path, ecv::OpenMode::kReadOnly).LoadModels());
   start = Clock::now();
   const size_t flat_models = ReadFlat(flat).size();
-  const double flat_ms = Milliseconds(start);
+  const double flat_ms = MillisecondsSince(start);
   std::cerr << "scaling " << count << ": " << matches << " + " << library_matches << " matches, " << flat_models
             << " flat models\n";
   return "| " + std::to_string(count) + " | " + std::to_string(library.NumViews()) + " | " +
@@ -366,36 +368,6 @@ std::string ScalingRow(const Settings& settings, const ScalingMeshes& meshes, in
 }
 
 // ---- main ---------------------------------------------------------------------------------------------------
-
-Settings ParseArguments(int argc, char** argv) {
-  Settings settings;
-  settings.command = ecv::bench::CommandLine(argc, argv);
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string flag = argv[i], value = argv[i + 1];
-    if (flag == "--views")
-      settings.views = std::stoi(value);
-    else if (flag == "--scale-views")
-      settings.scale_views = std::stoi(value);
-    else if (flag == "--study-views")
-      settings.study_views = std::stoi(value);
-    else if (flag == "--fit-views")
-      settings.fit_views = std::stoi(value);
-    else if (flag == "--scales") {
-      settings.scales.clear();
-      std::istringstream list(value);
-      for (std::string item; std::getline(list, item, ',');) settings.scales.push_back(std::stoi(item));
-    } else if (flag == "--data")
-      settings.data = value;
-    else if (flag == "--work")
-      settings.work = value;
-    else if (flag == "--results")
-      settings.results = value;
-    else
-      throw std::runtime_error("unknown flag " + flag);
-  }
-  if (argc % 2 == 0) throw std::runtime_error("every flag takes a value");
-  return settings;
-}
 
 std::string ScalesText(const std::vector<int>& scales) {
   std::string text;
@@ -411,8 +383,29 @@ std::string LoadRow(const std::string& what, double sqlite_ms, double flat_ms, d
 }  // namespace
 
 int main(int argc, char** argv) {
+  Settings settings;
+  settings.command = ecv::bench::CommandLine(argc, argv);
+  CLI::App app{
+      "modeldb_bench: the model library on the textured YCB meshes: build time per step, size, load time "
+      "against a flat file, how many views are needed, and scaling to 1000 models.",
+      "modeldb_bench"};
+  app.add_option("--views", settings.views, "Views per model of the library built and loaded")->capture_default_str();
+  app.add_option("--fit-views", settings.fit_views,
+                 "Views per model of the comparison build with the views as close as each object fits the image")
+      ->capture_default_str();
+  app.add_option("--scale-views", settings.scale_views, "Views per synthesised model in the scaling part")
+      ->capture_default_str();
+  app.add_option("--study-views", settings.study_views, "Held-out views per object in the how-many-views study")
+      ->capture_default_str();
+  app.add_option("--scales", settings.scales, "Library sizes (models) of the scaling part, comma-separated")
+      ->delimiter(',')
+      ->capture_default_str();
+  app.add_option("--data", settings.data, "Data directory (with ycbv_subset)")->capture_default_str();
+  app.add_option("--work", settings.work, "Directory for the libraries built (their files are replaced)")
+      ->capture_default_str();
+  app.add_option("--results", settings.results, "Markdown file the report is appended to")->capture_default_str();
+  if (const auto exit_code = ecv::bench::ParseCommandLine(app, argc, argv)) return *exit_code;
   try {
-    const Settings settings = ParseArguments(argc, argv);
     fs::create_directories(settings.work);
     const std::string path = settings.work + "/ycb.sqlite";
     fs::remove(path);
@@ -429,7 +422,7 @@ int main(int argc, char** argv) {
     WriteFlat(settings.work + "/ycb.bin", stored);
     auto start = Clock::now();
     const size_t flat_models = ReadFlat(settings.work + "/ycb.bin").size();
-    const double flat_ms = Milliseconds(start);
+    const double flat_ms = MillisecondsSince(start);
     std::string load_table =
         "| library | SQLite read ms | flat file read ms | ratio | matchers ms |\n|---|---:|---:|---:|---:|\n";
     load_table += LoadRow(std::to_string(flat_models) + " YCB models x " + std::to_string(settings.views) + " views (" +

@@ -12,14 +12,16 @@
 //   scripts/build_lmo_library /tmp/lmo.sqlite --views 40 --distance 1.0
 //   ranking_bench --db /tmp/lmo.sqlite --lmo
 
+#include <CLI/CLI.hpp>
+
 #include <algorithm>
-#include <cstring>
 #include <iostream>
 #include <map>
 #include <set>
 #include <sstream>
 
 #include "bench_util.h"
+#include "core/timing.h"
 #include "io/frame_io.h"
 #include "modeldb/model_library.h"
 #include "recognize/recognizer.h"
@@ -85,7 +87,7 @@ std::string Run(const ModelLibrary& library, const RecognizerOptions& options, c
       if (views == ranked.end()) continue;
       present.insert(truth.object_name);
       ModelTally& tally = tallies[truth.object_name];
-      ConsistencyOptions consistency = options.consistency;
+      ConsistencyOptions consistency = options.ranking.consistency;
       consistency.max_distance_m = diameters[truth.object_name];
       std::vector<JudgedView> judged;
       for (size_t rank = 0; rank < views->second.size(); ++rank) {
@@ -140,37 +142,30 @@ int Main(int argc, char** argv) {
   RecognizerOptions options;
   options.ransac.threads = 1;
   bool lmo = false;
-  for (int i = 1; i < argc; ++i) {
-    const bool has_value = i + 1 < argc;
-    if (has_value && std::strcmp(argv[i], "--db") == 0) {
-      db = argv[++i];
-    } else if (has_value && std::strcmp(argv[i], "--results") == 0) {
-      results = argv[++i];
-    } else if (std::strcmp(argv[i], "--lmo") == 0) {
-      lmo = true;
-    } else if (has_value && std::strcmp(argv[i], "--seed") == 0) {
-      options.ransac.seed = std::stoull(argv[++i]);
-    } else if (has_value && std::strcmp(argv[i], "--ranking-checks") == 0) {
-      options.ranking_checks = std::stoi(argv[++i]);
-    } else {
-      db.clear();
-      break;
-    }
-  }
-  if (db.empty()) {
-    std::cerr << "usage: ranking_bench --db LIB.sqlite [--lmo] [--seed N] [--ranking-checks N] [--results FILE]\n"
-                 "  (LIB: the 7 textured YCB-Video models, scripts/build_ycbv_library LIB --views 40 --distance 0.9;\n"
-                 "  with --lmo the LM-O frame, scripts/build_lmo_library LIB --views 40 --distance 1.0)\n";
-    return 2;
-  }
+  CLI::App app{
+      "ranking_bench: view ranking against the ground truth: do the library views the recognizer tries "
+      "first hold right correspondences? No RANSAC, no verification.",
+      "ranking_bench"};
+  app.add_option("--db", db, "Model library: the 7 YCB-Video models, or with --lmo the LM-O models")->required();
+  app.add_flag("--lmo", lmo, "Rank on the LM-O frame instead of the 30 YCB-Video frames");
+  app.add_option("--seed", options.ransac.seed, "Seed that picks each view's ranking descriptors")
+      ->capture_default_str();
+  app.add_option("--ranking-checks", options.ranking.checks,
+                 "Descriptors compared per query when ranking (0: as many as matching)")
+      ->capture_default_str();
+  app.add_option("--results", results, "Markdown file the report is appended to")->capture_default_str();
+  app.footer(
+      "Libraries:\n  scripts/build_ycbv_library YCBV_LIB.sqlite --views 40 --distance 0.9\n"
+      "  scripts/build_lmo_library LMO_LIB.sqlite --views 40 --distance 1.0 (with --lmo)");
+  if (const auto exit_code = ParseCommandLine(app, argc, argv)) return *exit_code;
   const ModelLibrary library = ModelLibrary::Load(db);
   std::vector<double> ms;
   const std::string table = Run(library, options, Frames(lmo), &ms);
   std::ostringstream markdown;
   markdown << "Library `" << db << "` (" << library.models().size() << " models), the " << ms.size()
            << (lmo ? " LM-O frame (scene 000002, image 3)" : " YCB-Video frames") << ", seed " << options.ransac.seed
-           << " (it picks each view's " << options.consistency_max_correspondences << " ranking descriptors, "
-           << options.ranking_checks << " checks per query; 0: as matching, " << options.match.checks
+           << " (it picks each view's " << options.ranking.max_correspondences << " ranking descriptors, "
+           << options.ranking.checks << " checks per query; 0: as matching, " << options.match.checks
            << "), one thread. Right = the ground truth puts the view primitive within " << kRightM * 100.0F
            << " cm of its scene primitive; good view = " << kGoodView
            << " or more right. Score = the ranking's consistent-set size. Median ms per frame for describing the "

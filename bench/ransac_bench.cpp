@@ -12,13 +12,16 @@
 
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
+
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <numeric>
-#include <stdexcept>
 #include <string>
 #include <thread>
 #include <type_traits>
@@ -28,6 +31,7 @@
 #include "core/error.h"
 #include "core/point_index.h"
 #include "core/pose.h"
+#include "core/timing.h"
 #include "ransac_pairs.h"
 #include "ransac_peer_open3d.h"
 #include "ransac_peer_pcl.h"
@@ -392,73 +396,42 @@ std::string LoadAverage() {
   return one_minute.empty() ? "unknown" : one_minute;
 }
 
-int ParseCount(const std::string& flag, const std::string& value) {
-  int count = 0;
-  try {
-    size_t used = 0;
-    count = std::stoi(value, &used);
-    if (used != value.size()) count = 0;
-  } catch (const std::exception&) {
-    count = 0;
-  }
-  if (count < 1) throw std::invalid_argument(flag + ": expected a whole number >= 1, got '" + value + "'");
-  return count;
-}
-
-Settings ParseArguments(int argc, char** argv) {
-  Settings settings;
-  settings.command = CommandLine(argc, argv);
-  bool standard_runs_given = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string flag = argv[i];
-    if (flag == "--no-peers") {
-      settings.peers = false;
-      continue;
-    }
-    if (i + 1 >= argc) throw std::invalid_argument("missing value after " + flag);
-    const std::string value = argv[++i];
-    if (flag == "--runs") {
-      settings.runs = ParseCount(flag, value);
-    } else if (flag == "--standard-runs") {
-      settings.standard_runs = ParseCount(flag, value);
-      standard_runs_given = true;
-    } else if (flag == "--paper-runs") {
-      settings.paper_runs = value == "0" ? 0 : ParseCount(flag, value);
-    } else if (flag == "--iterations") {
-      settings.iterations = ParseCount(flag, value);
-    } else if (flag == "--results") {
-      settings.results = value;
-    } else if (flag == "--data") {
-      settings.data = value;
-    } else if (flag == "--python") {
-      settings.python = value;
-    } else if (flag == "--scratch") {
-      settings.scratch = value;
-    } else if (flag == "--note") {
-      settings.note = value;
-    } else {
-      throw std::invalid_argument("unknown flag " + flag);
-    }
-  }
-  if (!standard_runs_given) settings.standard_runs = settings.runs;
-  return settings;
-}
-
 }  // namespace
 }  // namespace ecv::bench
 
 int main(int argc, char** argv) {
   using namespace ecv::bench;
   Settings settings;
-  try {
-    settings = ParseArguments(argc, argv);
-  } catch (const std::invalid_argument& error) {
-    std::cerr
-        << "ransac_bench: " << error.what()
-        << "\nusage: ransac_bench [--runs N] [--standard-runs N] [--paper-runs N] [--iterations K] [--results FILE] "
-           "[--no-peers] [--data DIR] [--python EXE] [--scratch DIR] [--note TEXT]\n";
-    return 2;
-  }
+  settings.command = CommandLine(argc, argv);
+  CLI::App app{
+      "ransac_bench: prerejective against standard RANSAC at a fixed number of iterations (paper Table I), "
+      "and PCL's and Open3D's RANSAC, all on the same ECV correspondences of a rendered and a real view "
+      "pair.",
+      "ransac_bench"};
+  app.add_option("--runs", settings.runs, "Runs (seeds 1..N) per method and pair")
+      ->check(AtLeastOne())
+      ->capture_default_str();
+  CLI::Option* standard_runs = app.add_option("--standard-runs", settings.standard_runs,
+                                              "Runs of standard RANSAC, which is slow (default: as --runs)")
+                                   ->check(AtLeastOne());
+  app.add_option("--paper-runs", settings.paper_runs,
+                 "Runs of both variants without preverification, the paper's algorithm (0: none)")
+      ->check(CLI::Range(0, std::numeric_limits<int>::max()).description("NONNEGATIVE"))
+      ->capture_default_str();
+  app.add_option("--iterations", settings.iterations, "RANSAC iterations (samples drawn) per run")
+      ->check(AtLeastOne())
+      ->capture_default_str();
+  app.add_option("--results", settings.results, "Markdown file the report is appended to")->capture_default_str();
+  app.add_flag_callback(
+      "--no-peers", [&settings] { settings.peers = false; }, "Skip the PCL and Open3D peers");
+  app.add_option("--data", settings.data, "Data directory (with ycbv_subset)")->capture_default_str();
+  app.add_option("--python", settings.python, "Python interpreter with Open3D for the Open3D peer")
+      ->capture_default_str();
+  app.add_option("--scratch", settings.scratch,
+                 "Directory for the Open3D peer's input, kept (default: a temporary directory, removed)");
+  app.add_option("--note", settings.note, "Free text added to the report, e.g. the state of the tree (default: none)");
+  if (const auto exit_code = ParseCommandLine(app, argc, argv)) return *exit_code;
+  if (standard_runs->count() == 0) settings.standard_runs = settings.runs;
   try {
     const std::string load_before = LoadAverage();
     std::cerr << "rendering the wide-baseline pair and loading the real pair...\n";

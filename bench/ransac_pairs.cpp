@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "bench_util.h"
+#include "core/timing.h"
 #include "ecv/descriptor.h"
 #include "ecv/matching.h"
 #include "ecv/primitives.h"

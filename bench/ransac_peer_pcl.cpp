@@ -9,6 +9,7 @@
 #include <pcl/registration/sample_consensus_prerejective.h>
 
 #include "bench_util.h"
+#include "core/timing.h"
 
 namespace ecv::bench {
 namespace {

@@ -12,6 +12,7 @@
 #include <pcl/registration/sample_consensus_prerejective.h>
 
 #include "bench_util.h"
+#include "core/timing.h"
 #include "recognition_peers.h"
 
 namespace ecv::bench {

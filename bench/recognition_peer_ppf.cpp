@@ -9,6 +9,7 @@
 #include <opencv2/surface_matching/ppf_helpers.hpp>
 
 #include "bench_util.h"
+#include "core/timing.h"
 #include "recognition_peers.h"
 
 namespace ecv::bench {

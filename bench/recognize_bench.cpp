@@ -20,8 +20,9 @@
 // --object-pixels also runs the peers on depth cut to the ground-truth objects' own pixels; --peers-only,
 // --frame-step, --ppf-sampling, --ppf-scene-distance and --min-inlier-fraction are for tuning the peers.
 
+#include <CLI/CLI.hpp>
+
 #include <algorithm>
-#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <map>
@@ -32,9 +33,11 @@
 
 #include "bench_util.h"
 #include "core/byte_neighbours.h"
+#include "core/timing.h"
 #include "io/frame_io.h"
 #include "recognition_peers.h"
 #include "recognize/evaluation.h"
+#include "recognize/recognition_stream.h"
 #include "recognize/recognizer.h"
 
 namespace ecv::bench {
@@ -123,19 +126,13 @@ Run RunRecognizer(const ModelLibrary& library, const RecognizerOptions& options,
                   const std::vector<EvalModel>& models, const std::string& label, bool track = false,
                   int search_every = 1) {
   Recognizer recognizer(library, options);
+  RecognitionStream stream(recognizer, {track, search_every});
   Run run;
-  std::vector<Detection> previous;
-  int in_video = 0;  // frames of the video before this one
   for (size_t i = 0; i < frames.size(); ++i) {
+    // Each video is a stream of its own.
     const auto video = [&](size_t k) { return frames[k].name.substr(0, frames[k].name.find('/')); };
-    if (i > 0 && video(i) != video(i - 1)) {
-      previous.clear();
-      in_video = 0;
-    }
-    const SearchScope scope = in_video++ % search_every == 0 ? SearchScope::kAllModels : SearchScope::kLostTracks;
-    const RecognitionResult result = track ? recognizer.Recognize(frames[i].frame.rgbd, previous, scope)
-                                           : recognizer.Recognize(frames[i].frame.rgbd);
-    previous = result.detections;
+    if (i > 0 && video(i) != video(i - 1)) stream.Reset();
+    const RecognitionResult result = stream.Next(frames[i].frame.rgbd);
     run.frames.push_back(EvaluateFrame(frames[i].name, result.detections, frames[i].frame.ground_truth, models));
     run.detections.push_back(result.detections);
     for (const auto& [stage, ms] : result.timings_ms) run.stage_ms[stage].push_back(ms);
@@ -364,7 +361,7 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
     }
     if (methods.preselect > 0) {
       RecognizerOptions preselecting = options;
-      preselecting.preselect_models = methods.preselect;
+      preselecting.preselect.models = methods.preselect;
       runs.emplace_back(Preselecting(methods.preselect),
                         RunRecognizer(library, preselecting, frames, models, "preselect"));
     }
@@ -510,80 +507,68 @@ int main(int argc, char** argv) {
   int limit = 0, step = 1;
   Methods methods;
   PeerOptions peer_options;
-  for (int i = 1; i < argc; ++i) {
-    const bool has_value = i + 1 < argc;
-    if (std::strcmp(argv[i], "--peers") == 0) {
-      methods.peers = true;
-    } else if (std::strcmp(argv[i], "--peers-only") == 0) {  // for tuning the peers
-      methods.peers = true;
-      methods.ours = false;
-    } else if (std::strcmp(argv[i], "--object-pixels") == 0) {
-      methods.object_pixels = true;
-    } else if (has_value && std::strcmp(argv[i], "--threads") == 0) {
-      methods.threads = std::atoi(argv[++i]);
-      if (methods.threads < 1) {
-        db.clear();
-        break;
-      }
-    } else if (std::strcmp(argv[i], "--bytes") == 0) {
-      if (!ByteNeighbours::CpuHasVnni()) {
-        std::cerr << "recognize_bench: --bytes needs AVX-512 VNNI, which this CPU lacks\n";
-        return 2;
-      }
-      methods.bytes = true;
-    } else if (has_value && std::strcmp(argv[i], "--preselect") == 0) {
-      methods.preselect = std::atoi(argv[++i]);
-      if (methods.preselect < 1) {
-        db.clear();
-        break;
-      }
-    } else if (std::strcmp(argv[i], "--turned") == 0) {
-      methods.turned = true;
-    } else if (std::strcmp(argv[i], "--track") == 0) {
-      methods.track = true;
-    } else if (has_value && std::strcmp(argv[i], "--search-every") == 0) {
-      methods.track = true;
-      methods.search_every = std::atoi(argv[++i]);
-      if (methods.search_every < 1) {
-        db.clear();
-        break;
-      }
-    } else if (has_value && std::strcmp(argv[i], "--frame-step") == 0) {
-      step = std::atoi(argv[++i]);
-    } else if (has_value && std::strcmp(argv[i], "--ppf-sampling") == 0) {
-      peer_options.ppf_relative_sampling = std::atof(argv[++i]);
-    } else if (has_value && std::strcmp(argv[i], "--ppf-scene-distance") == 0) {
-      peer_options.ppf_scene_distance = std::atof(argv[++i]);
-    } else if (has_value && std::strcmp(argv[i], "--min-inlier-fraction") == 0) {
-      peer_options.min_inlier_fraction = std::atof(argv[++i]);
-    } else if (has_value && std::strcmp(argv[i], "--figure") == 0) {
-      figure = argv[++i];
-    } else if (has_value && std::strcmp(argv[i], "--python") == 0) {
-      methods.python = argv[++i];
-    } else if (has_value && std::strcmp(argv[i], "--db") == 0) {
-      db = argv[++i];
-    } else if (has_value && std::strcmp(argv[i], "--lmo-db") == 0) {
-      lmo_db = argv[++i];
-    } else if (has_value && std::strcmp(argv[i], "--results") == 0) {
-      results = argv[++i];
-    } else if (has_value && std::strcmp(argv[i], "--frames") == 0) {
-      limit = std::atoi(argv[++i]);
-    } else {
-      db.clear();
-      break;
-    }
-  }
-  if (db.empty()) {
-    std::cerr
-        << "usage: recognize_bench --db LIB.sqlite [--lmo-db LMO.sqlite] [--peers | --peers-only] [--object-pixels]\n"
-           "         [--track] [--search-every N] [--threads N] [--bytes] [--preselect N] [--turned] [--python EXE]\n"
-           "         [--figure F.jpg]\n"
-           "         [--results FILE] [--frames N] [--frame-step S] [--ppf-sampling R] [--ppf-scene-distance R]\n"
-           "         [--min-inlier-fraction F]\n"
-           "  (build the libraries with scripts/build_ycbv_library LIB.sqlite --views 40 --distance 0.9 and\n"
-           "   scripts/build_lmo_library LMO.sqlite --views 40 --distance 1.0)\n";
-    return 2;
-  }
+  CLI::App app{
+      "recognize_bench: recognition on the real YCB-Video frames (and the LM-O frame) scored against the "
+      "ground truth (recall at ADD < 0.1 d, false positives) with the time per stage; PCL, OpenCV PPF and "
+      "Open3D as peers.",
+      "recognize_bench"};
+  app.add_option("--db", db, "Library of the YCB-Video models")->required();
+  app.add_option("--lmo-db", lmo_db,
+                 "Library of the LM-O models: also the LM-O frame, as its own table (default: not run)");
+  app.add_flag("--peers", methods.peers, "Also run the peers (PCL, OpenCV PPF, Open3D) on the same frames");
+  app.add_flag_callback(
+      "--peers-only",
+      [&methods] {
+        methods.peers = true;
+        methods.ours = false;
+      },
+      "Run the peers only, not ours (for tuning the peers)");
+  app.add_flag("--object-pixels", methods.object_pixels,
+               "Also run the peers on depth cut to the ground-truth objects' own pixels");
+  app.add_flag("--track", methods.track, "Also run ours with the previous frame's detections as priors");
+  app.add_option_function<int>(
+         "--search-every",
+         [&methods](const int& every) {
+           methods.track = true;
+           methods.search_every = every;
+         },
+         "Implies --track; N > 1 also runs ours searching untracked models only every N-th frame (default: 1)")
+      ->check(AtLeastOne());
+  app.add_option("--threads", methods.threads, "N > 1 also runs ours with N worker threads (same detections checked)")
+      ->check(AtLeastOne())
+      ->capture_default_str();
+  app.add_flag_callback(
+      "--bytes",
+      [&methods] {
+        if (!ByteNeighbours::CpuHasVnni())
+          throw CLI::ValidationError("--bytes", "needs AVX-512 VNNI, which this CPU lacks");
+        methods.bytes = true;
+      },
+      "Also run ours matching with ByteNeighbours (recognize --matcher bytes; needs AVX-512 VNNI)");
+  app.add_option("--preselect", methods.preselect,
+                 "Also run ours searching only the N models a quick look scores best (default: no such run)")
+      ->check(AtLeastOne());
+  app.add_flag("--turned", methods.turned, "Also run ours on the frames turned 180 degrees (ground truth moved)");
+  app.add_option("--python", methods.python, "Python interpreter with Open3D for the Open3D peer")
+      ->capture_default_str();
+  app.add_option("--figure", figure,
+                 "Picture of the detections of ours and each peer in the demo frame 0001/000001 (default: none)");
+  app.add_option("--results", results, "Markdown file the report is appended to")->capture_default_str();
+  app.add_option("--frames", limit, "Only the first N YCB-Video frames (0: all 30)")->capture_default_str();
+  app.add_option("--frame-step", step, "Every S-th YCB-Video frame only (for tuning the peers)")->capture_default_str();
+  app.add_option("--ppf-sampling", peer_options.ppf_relative_sampling,
+                 "OpenCV PPF peer: model sampling step, relative to the model's box")
+      ->capture_default_str();
+  app.add_option("--ppf-scene-distance", peer_options.ppf_scene_distance,
+                 "OpenCV PPF peer: scene sampling step, relative to the scene's box")
+      ->capture_default_str();
+  app.add_option("--min-inlier-fraction", peer_options.min_inlier_fraction,
+                 "Peers: share of a model's points within 1 cm of the scene after ICP to report it")
+      ->capture_default_str();
+  app.footer(
+      "Libraries:\n  scripts/build_ycbv_library YCBV_LIB.sqlite --views 40 --distance 0.9\n"
+      "  scripts/build_lmo_library LMO_LIB.sqlite --views 40 --distance 1.0");
+  if (const auto exit_code = ParseCommandLine(app, argc, argv)) return *exit_code;
   try {
     peer_options.Check();
     std::ostringstream markdown, notes;

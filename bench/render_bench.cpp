@@ -4,8 +4,9 @@
 //
 //   render_bench [--views N] [--data DIR] [--results FILE] [--figure FILE]
 
+#include <CLI/CLI.hpp>
+
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <ctime>
 #include <fstream>
@@ -16,6 +17,7 @@
 #include <vector>
 
 #include "bench_util.h"
+#include "core/timing.h"
 #include "io/frame_io.h"
 #include "io/mesh_io.h"
 #include "render/overlay.h"
@@ -25,10 +27,10 @@
 
 namespace {
 
-using ecv::bench::Clock;
+using ecv::Clock;
+using ecv::MillisecondsSince;
 using ecv::bench::Fixed;
 using ecv::bench::MachineDescription;
-constexpr auto Milliseconds = ecv::bench::MillisecondsSince;
 
 const char* const kObjects[] = {"003_cracker_box",    "004_sugar_box",   "005_tomato_soup_can",
                                 "006_mustard_bottle", "009_gelatin_box", "010_potted_meat_can"};
@@ -57,10 +59,10 @@ std::string BenchmarkMesh(ecv::Renderer& renderer, const Settings& settings, con
                           const ecv::PinholeCamera& camera) {
   auto start = Clock::now();
   const ecv::TriangleMesh mesh = LoadYcbMesh(settings.data, object);
-  const double load_ms = Milliseconds(start);
+  const double load_ms = MillisecondsSince(start);
   start = Clock::now();
   const ecv::MeshId id = renderer.AddMesh(mesh);
-  const double upload_ms = Milliseconds(start);
+  const double upload_ms = MillisecondsSince(start);
   ecv::ViewSamplingOptions sampling;
   sampling.num_views = settings.views;
   const auto views = ecv::SampleViews(ecv::ComputeBoundingSphere(mesh), camera, sampling);
@@ -69,7 +71,7 @@ std::string BenchmarkMesh(ecv::Renderer& renderer, const Settings& settings, con
   for (const Eigen::Isometry3d& camera_from_object : views) {
     start = Clock::now();
     const ecv::RenderResult rendered = renderer.Render(id, camera, camera_from_object);
-    times.push_back(Milliseconds(start));
+    times.push_back(MillisecondsSince(start));
     covered += static_cast<double>(cv::countNonZero(rendered.mask)) / rendered.mask.total() / views.size();
   }
   renderer.RemoveMesh(id);
@@ -98,38 +100,26 @@ void SaveOverlayFigure(ecv::Renderer& renderer, const Settings& settings) {
   }
 }
 
-Settings ParseArguments(int argc, char** argv) {
-  Settings settings;
-  settings.command = "render_bench";
-  for (int i = 1; i < argc; ++i) {
-    const std::string flag = argv[i];
-    settings.command += " " + flag;
-    if (i + 1 >= argc) throw std::runtime_error("missing value after " + flag);
-    const std::string value = argv[++i];
-    settings.command += " " + value;
-    if (flag == "--views")
-      settings.views = std::stoi(value);
-    else if (flag == "--data")
-      settings.data = value;
-    else if (flag == "--results")
-      settings.results = value;
-    else if (flag == "--figure")
-      settings.figure = value;
-    else
-      throw std::runtime_error("unknown flag " + flag);
-  }
-  return settings;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
+  Settings settings;
+  CLI::App app{
+      "render_bench: milliseconds per 640x480 view of the textured YCB meshes with one OSMesa context "
+      "reused, and the overlay figure of the cracker box at its ground-truth pose.",
+      "render_bench"};
+  app.add_option("--views", settings.views, "Views rendered per mesh")->capture_default_str();
+  app.add_option("--data", settings.data, "Data directory (with ycbv_subset)")->capture_default_str();
+  app.add_option("--results", settings.results, "Markdown file the report is appended to")->capture_default_str();
+  app.add_option("--figure", settings.figure, "File the overlay picture is written to")->capture_default_str();
+  if (const auto exit_code = ecv::bench::ParseCommandLine(app, argc, argv)) return *exit_code;
+  settings.command = "render_bench";  // the arguments as given, without the program's path
+  for (int i = 1; i < argc; ++i) settings.command += std::string(" ") + argv[i];
   try {
-    const Settings settings = ParseArguments(argc, argv);
     const ecv::PinholeCamera camera{1066.778, 1067.487, 312.9869, 241.3109, 640, 480};  // YCB-Video
     auto start = Clock::now();
     ecv::Renderer renderer;
-    const double context_ms = Milliseconds(start);
+    const double context_ms = MillisecondsSince(start);
     std::string table =
         "| mesh | triangles | texture | load ms | upload ms | ms/view median | mean | max | object pixels % |\n"
         "|---|---|---|---|---|---|---|---|---|\n";

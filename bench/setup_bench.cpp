@@ -10,6 +10,8 @@
 //   setup_bench --db /tmp/ycbv.sqlite [--frame YCBV_PREFIX] [--rounds 3] [--threads 2] [--work DIR]
 //               [--results FILE]
 
+#include <CLI/CLI.hpp>
+
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -20,6 +22,7 @@
 #include <vector>
 
 #include "bench_util.h"
+#include "core/timing.h"
 #include "modeldb/model_library.h"
 #include "modeldb/sql.h"
 #include "recognize/evaluation.h"
@@ -27,10 +30,10 @@
 
 namespace {
 
-using ecv::bench::Clock;
+using ecv::Clock;
+using ecv::MillisecondsSince;
 using ecv::bench::Fixed;
 using ecv::bench::Median;
-constexpr auto Milliseconds = ecv::bench::MillisecondsSince;
 namespace fs = std::filesystem;
 
 struct Settings {
@@ -48,33 +51,6 @@ struct Times {
   std::vector<double> read, meshes, setup, frame, eval, open3d;
   std::string detections;  // of the last round
 };
-
-Settings ParseArguments(int argc, char** argv) {
-  Settings settings;
-  settings.command = ecv::bench::CommandLine(argc, argv);
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string flag = argv[i], value = argv[i + 1];
-    if (flag == "--db")
-      settings.db = value;
-    else if (flag == "--frame")
-      settings.frame = value;
-    else if (flag == "--rounds")
-      settings.rounds = std::stoi(value);
-    else if (flag == "--threads")
-      settings.threads = std::stoi(value);
-    else if (flag == "--work")
-      settings.work = value;
-    else if (flag == "--results")
-      settings.results = value;
-    else
-      throw std::runtime_error("unknown flag " + flag);
-  }
-  if (argc % 2 == 0 || settings.db.empty() || settings.rounds < 1 || settings.threads < 1) {
-    throw std::runtime_error(
-        "usage: setup_bench --db LIB.sqlite [--frame PREFIX] [--rounds N] [--threads N] [--work DIR] [--results F]");
-  }
-  return settings;
-}
 
 double MegaBytes(const std::string& path) {
   return static_cast<double>(fs::file_size(path)) / 1e6;
@@ -108,23 +84,23 @@ void RunVariant(const Settings& settings, const std::string& path, const ecv::Lo
   load.build_matchers = false;  // as `recognize` loads it
   auto start = Clock::now();
   const ecv::ModelLibrary library = ecv::ModelLibrary::Load(path, load);
-  times->read.push_back(Milliseconds(start));
+  times->read.push_back(MillisecondsSince(start));
   start = Clock::now();
   size_t triangles = 0;
   for (const ecv::LibraryModel& model : library.models()) triangles += ecv::ModelMesh(model.record).NumTriangles();
-  times->meshes.push_back(Milliseconds(start));
+  times->meshes.push_back(MillisecondsSince(start));
   ecv::RecognizerOptions options;
   options.ransac.threads = settings.threads;
   start = Clock::now();
   ecv::Recognizer recognizer(library, options);
-  times->setup.push_back(Milliseconds(start));
+  times->setup.push_back(MillisecondsSince(start));
   start = Clock::now();
   const ecv::RecognitionResult result = recognizer.Recognize(frame.rgbd);
-  times->frame.push_back(Milliseconds(start));
+  times->frame.push_back(MillisecondsSince(start));
   times->detections = Signature(result.detections);
   start = Clock::now();
   const std::vector<ecv::EvalModel> models = ecv::EvalModels(library);
-  times->eval.push_back(Milliseconds(start));
+  times->eval.push_back(MillisecondsSince(start));
   if (with_peer) times->open3d.push_back(Open3dMeshLoadMs(library));
   std::cerr << path << ": " << library.models().size() << " models, " << triangles << " triangles, "
             << result.detections.size() << " detections, read + set-up " << Fixed(times->read.back(), 0) << " + "
@@ -141,8 +117,26 @@ std::string Row(const std::string& what, double megabytes, const Times& t) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  Settings settings;
+  settings.command = ecv::bench::CommandLine(argc, argv);
+  CLI::App app{
+      "setup_bench: what a one-frame recognize pays before recognising (library read, meshes, Recognizer "
+      "set-up, first frame, eval's models), with the meshes stored in the library or read from their files.",
+      "setup_bench"};
+  app.add_option("--db", settings.db, "Model library with stored meshes")->required();
+  app.add_option("--frame", settings.frame, "Frame recognised (a YCB-Video prefix, or any FRAME that recognize takes)")
+      ->capture_default_str();
+  app.add_option("--rounds", settings.rounds, "Rounds, the two variants alternated")
+      ->check(ecv::bench::AtLeastOne())
+      ->capture_default_str();
+  app.add_option("--threads", settings.threads, "Recognizer threads")
+      ->check(ecv::bench::AtLeastOne())
+      ->capture_default_str();
+  app.add_option("--work", settings.work, "Directory for the library copy without meshes")->capture_default_str();
+  app.add_option("--results", settings.results, "Markdown file the report is appended to")->capture_default_str();
+  app.footer("Library:\n  scripts/build_ycbv_library /tmp/ycbv.sqlite --views 40 --distance 0.9");
+  if (const auto exit_code = ecv::bench::ParseCommandLine(app, argc, argv)) return *exit_code;
   try {
-    const Settings settings = ParseArguments(argc, argv);
     fs::create_directories(settings.work);
     const std::string files = settings.work + "/files.sqlite";  // the same library without its stored meshes
     fs::copy_file(settings.db, files, fs::copy_options::overwrite_existing);

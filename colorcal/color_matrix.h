@@ -40,7 +40,7 @@ enum class ColorMatrixForm {
 
 const char* ToString(ColorMatrixForm form);
 
-/// Options of the colour-matrix fit (paper Sect. IV-C; DESIGN.md "Colour calibration"). Defaults measured by
+/// Options of the colour-matrix fit (paper Sect. IV-C). Defaults measured by
 /// bench/colorcal_bench (bench/RESULTS.md, "Colour calibration"): with 10 hand-labelled pairs of which 20-40 % are
 /// mislabelled, kRansac is as good as least squares on the correct pairs alone, where kTukeyIrls breaks down from
 /// 30 %; on automatic pairs from real frames kRansac ends where kTukeyIrls does (the polish), also for one matrix

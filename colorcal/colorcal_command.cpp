@@ -222,7 +222,7 @@ int RunClear(const ColorcalArgs& args) {
 
 CLI::App* AddModelCommand(CLI::App& command, const char* name, const char* summary, ColorcalArgs* args) {
   CLI::App* sub = command.add_subcommand(name, summary);
-  sub->add_option("--db", args->db, "Model library file (SQLite)")->required();
+  AddDbOption(*sub, &args->db);
   sub->add_option("--model", args->model, "Model name")->required();
   return sub;
 }

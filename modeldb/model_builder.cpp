@@ -1,4 +1,4 @@
-// Building a library model from a mesh (DESIGN.md, offline data flow): render N views, extract ECV primitives
+// Building a library model from a mesh (the offline data flow): render N views, extract ECV primitives
 // (paper Sect. II-A) in each, move them into the object frame, and compute the context descriptors per view
 // (Sect. II-B; invariant to the rigid move, so computing them in the object frame changes nothing but lets a
 // reloaded model reproduce them bit for bit).

@@ -33,15 +33,14 @@ struct ModelBuildOptions {
   RenderOptions render;                     ///< shading etc. (unlit: the texture's colours as stored)
   /// Beyond the paper: BuildModel renders a mesh without any texture (vertex or material colours only) with
   /// headlight shading even when `render.shading` is unlit. A camera sees such an object's form through its
-  /// shading; flat colours show little but the silhouette. On the LM-O frame (8 scanned, vertex-coloured
-  /// models) 2 of 8 objects found instead of 0, with no false positive (bench/RESULTS.md, session 16); textured
-  /// meshes keep their texture as stored (on YCB-Video, headlight found 169 of 210 with seeds 1-3, as unlit did).
+  /// shading; flat colours show little but the silhouette (it finds more of the LM-O frame's scanned models:
+  /// bench/RESULTS.md). Textured meshes keep their texture as stored.
   /// The recognizer renders each model in verification as its views were (StoredViewShading).
   bool shade_untextured = true;
   FeatureSettings features;  ///< extraction and descriptor settings
   /// Store the mesh in the record (ModelRecord::mesh_blob), so that recognition verifies poses without the mesh
-  /// file and without decoding its full-size textures (the 7 YCB models, 4096 px PNG textures: setup_bench in
-  /// bench/RESULTS.md, session 28). Textures are kept up to mesh_blob.max_texture_size (the recognizer's own cap).
+  /// file and without decoding its full-size textures (bench/RESULTS.md, setup_bench). Textures are kept up to
+  /// mesh_blob.max_texture_size (the recognizer's own cap).
   bool store_mesh = true;
   MeshBlobOptions mesh_blob;
   int threads = 1;  ///< worker threads describing each view (ComputeDescriptors); the model does not depend on it

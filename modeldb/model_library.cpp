@@ -1,11 +1,10 @@
 #include "modeldb/model_library.h"
 
-#include <atomic>
 #include <chrono>
 #include <stdexcept>
-#include <thread>
 
 #include "core/error.h"
+#include "core/parallel.h"
 #include "core/timing.h"
 
 namespace ecv {
@@ -18,19 +17,12 @@ void BuildMatchers(std::vector<LibraryModel>* models, const LibraryLoadOptions& 
     (*models)[m].matchers.resize((*models)[m].record.views.size());
     for (size_t v = 0; v < (*models)[m].record.views.size(); ++v) jobs.emplace_back(m, v);
   }
-  std::atomic<size_t> next{0};
-  auto work = [&] {
-    for (size_t job = next++; job < jobs.size(); job = next++) {
-      LibraryModel& model = (*models)[jobs[job].first];
-      const ModelView& view = model.record.views[jobs[job].second];
-      model.matchers[jobs[job].second] =
-          std::make_unique<DescriptorMatcher>(view.primitives, view.descriptors, options.match);
-    }
-  };
-  std::vector<std::thread> workers;
-  for (int t = 1; t < options.threads; ++t) workers.emplace_back(work);
-  work();
-  for (std::thread& worker : workers) worker.join();
+  ParallelFor(jobs.size(), options.threads, [&](size_t job) {
+    LibraryModel& model = (*models)[jobs[job].first];
+    const ModelView& view = model.record.views[jobs[job].second];
+    model.matchers[jobs[job].second] =
+        std::make_unique<DescriptorMatcher>(view.primitives, view.descriptors, options.match);
+  });
 }
 
 }  // namespace

@@ -303,7 +303,7 @@ int RunMigrate(const ModeldbArgs& args) {
 
 CLI::App* AddDatabaseCommand(CLI::App& command, const char* name, const char* summary, ModeldbArgs* args) {
   CLI::App* sub = command.add_subcommand(name, summary);
-  sub->add_option("--db", args->db, "Model library file (SQLite)")->required();
+  AddDbOption(*sub, &args->db);
   return sub;
 }
 

@@ -10,6 +10,7 @@
 #include "app/commands.h"
 #include "app/frame_args.h"
 #include "core/error.h"
+#include "io/atomic_file.h"
 #include "io/frame_io.h"
 #include "io/pose_io.h"
 #include "modeldb/model_library.h"
@@ -46,16 +47,6 @@ std::vector<FrameEvaluation> EvaluateOneFrame(const EvalArgs& args, const std::v
   return {EvaluateFrame(frame.rgbd.name, detections, frame.ground_truth, models)};
 }
 
-void WriteText(const std::string& path, const std::string& text) {
-  const std::string temporary = path + ".tmp";
-  {
-    std::ofstream out(temporary);
-    out << text;
-    if (!out) ThrowInputError(path, "output", "a writable file");
-  }
-  std::filesystem::rename(temporary, path);
-}
-
 int RunEval(const EvalArgs& args) {
   const int forms =
       (args.frame.positional.empty() ? 0 : 1) + (args.gt_bop.empty() ? 0 : 1) + (args.gt_ycbv.empty() ? 0 : 1);
@@ -78,7 +69,7 @@ int RunEval(const EvalArgs& args) {
   }
   const std::string table = EvaluationMarkdown(frames);
   std::cout << table;
-  if (!args.out_markdown.empty()) WriteText(args.out_markdown, table);
+  if (!args.out_markdown.empty()) WriteFileAtomically(args.out_markdown, table);
   if (!args.out_json.empty()) WriteJsonFile(args.out_json, EvaluationToJson(frames));
   return kExitOk;
 }
@@ -92,7 +83,7 @@ CommandAction SetupEvalCommand(CLI::App& command) {
                   "Detections: JSON of one frame (recognize --out-json), the JSON Lines of recognize --sequence, "
                   "or a BOP CSV (recognize --out-bop)")
       ->required();
-  command.add_option("--db", args->db, "The model library the detections came from (meshes, diameters)")->required();
+  AddDbOption(command, &args->db, "The model library the detections came from (meshes, diameters)");
   command.add_option("FRAME", args->frame.positional, "YCB-Video prefix or BOP SCENE_DIR:IMAGE_ID with ground truth");
   command.add_option("--gt-bop", args->gt_bop, "BOP scene folder: ground truth from its scene_gt.json");
   command.add_option("--gt-ycbv", args->gt_ycbv, "YCB-Video video folder: ground truth from each frame's -meta.mat");

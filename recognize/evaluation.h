@@ -13,7 +13,7 @@
 
 namespace ecv {
 
-/// Errors of an estimated pose against the ground truth (DESIGN.md "Evaluation").
+/// Errors of an estimated pose against the ground truth.
 struct PoseError {
   double rotation_deg = 0.0;
   double translation_mm = 0.0;

@@ -16,9 +16,11 @@
 #include "core/error.h"
 #include "core/pose.h"
 #include "core/timing.h"
+#include "io/atomic_file.h"
 #include "io/frame_io.h"
 #include "io/pose_io.h"
 #include "modeldb/model_library.h"
+#include "recognize/recognition_stream.h"
 #include "recognize/recognizer.h"
 
 namespace ecv::app {
@@ -34,8 +36,7 @@ struct RecognizeArgs {
   std::string out_bop;
   int scene_id = -1, image_id = -1;
   std::string overlay;
-  bool track = false;
-  int search_every = 1;  // with track: models without a prior are searched on every n-th frame only
+  StreamOptions stream;
   std::string matcher = "kd-forest";
 };
 
@@ -99,18 +100,8 @@ void PrintDetections(const LoadedFrame& loaded, const RecognitionResult& result)
   std::cout << '\n';
 }
 
-// Writes `text` to `path` through a temporary file, so that a failed run leaves no half-written output.
-void WriteTextAtomically(const std::string& path, const std::string& text) {
-  const std::string temporary = path + ".tmp";
-  {
-    std::ofstream out(temporary);
-    out << text;
-    if (!out) ThrowInputError(path, "output", "a writable file");
-  }
-  std::filesystem::rename(temporary, path);
-}
-
-int RunRecognize(const RecognizeArgs& args) {
+// The recognizer's options from the flags, checked.
+RecognizerOptions OptionsFromArgs(const RecognizeArgs& args) {
   RecognizerOptions options = args.options;
   if (args.matcher == "bytes") {
     options.match.index = MatchIndex::kBytes;
@@ -123,27 +114,22 @@ int RunRecognize(const RecognizeArgs& args) {
   if (!args.sequence.empty() && (!args.frame.positional.empty() || args.frame.color_path.size() > 0)) {
     ThrowInputError("recognize", "--sequence", "either a sequence or one frame, not both");
   }
-  if (args.track && args.sequence.empty()) ThrowInputError("recognize", "--track", "a --sequence to track along");
-  if (args.search_every < 1) ThrowInputError("recognize", "--search-every", "at least 1");
-  if (args.search_every > 1 && !args.track) ThrowInputError("recognize", "--search-every", "--track as well");
-  std::vector<std::string> frames;
-  if (!args.sequence.empty()) frames = ListSequenceFrames(args.sequence);
-  // One frame is read first: a broken one is reported before the library and its meshes (seconds) are loaded.
-  std::optional<LoadedFrame> single;
-  if (frames.empty()) single.emplace(app::LoadFrameWithWarnings(args.frame));
-  LibraryLoadOptions load;
-  load.names = args.models;
-  load.build_matchers = false;  // the scene is indexed, the views are queried
-  const ModelLibrary library = ModelLibrary::Load(args.db, load);
-  std::cerr << "recognize: " << library.models().size() << " models, " << library.NumViews() << " views from "
-            << args.db << " (" << std::fixed << std::setprecision(0) << library.timings().read_ms << " ms)\n";
-  const Clock::time_point setup = Clock::now();
-  Recognizer recognizer(library, options);
+  if (args.stream.track && args.sequence.empty()) {
+    ThrowInputError("recognize", "--track", "a --sequence to track along");
+  }
+  if (args.stream.search_every < 1) ThrowInputError("recognize", "--search-every", "at least 1");
+  if (args.stream.search_every > 1 && !args.stream.track) {
+    ThrowInputError("recognize", "--search-every", "--track as well");
+  }
+  return options;
+}
+
+// Says on stderr how the meshes were loaded and how descriptors are matched.
+void ReportSetup(const ModelLibrary& library, const RecognizerOptions& options, double setup_ms) {
   const auto stored = std::count_if(library.models().begin(), library.models().end(),
                                     [](const LibraryModel& model) { return !model.record.mesh_blob.empty(); });
   std::cerr << "recognize: meshes loaded for verification (" << stored << " stored in the library, "
-            << library.models().size() - static_cast<size_t>(stored) << " from mesh files; " << MillisecondsSince(setup)
-            << " ms)\n";
+            << library.models().size() - static_cast<size_t>(stored) << " from mesh files; " << setup_ms << " ms)\n";
   std::cerr << "recognize: descriptors matched by ";
   if (options.match.index == MatchIndex::kBytes) {
     std::cerr << "bytes (" << (ByteNeighbours::CpuHasVnni() ? "AVX-512 VNNI" : "plain loop") << ", exact)\n";
@@ -151,30 +137,30 @@ int RunRecognize(const RecognizeArgs& args) {
     std::cerr << "kd-forest (" << options.match.trees << " trees, " << options.match.checks << " checks; view ranking "
               << options.RankingChecks() << ")\n";
   }
+}
 
-  if (single) {
-    const LoadedFrame& loaded = *single;
-    const RecognitionResult result = recognizer.Recognize(loaded.rgbd);
-    PrintDetections(loaded, result);
-    if (!args.out_json.empty()) WriteJsonFile(args.out_json, RecognitionToJson(result));
-    if (!args.out_bop.empty()) {
-      const auto [scene_id, image_id] = BopIds(args.frame.positional, args.scene_id, args.image_id);
-      std::ostringstream csv;
-      csv << "scene_id,im_id,obj_id,score,R,t,time\n";
-      AppendBopRows(csv, scene_id, image_id, result);
-      WriteTextAtomically(args.out_bop, csv.str());
-    }
-    if (!args.overlay.empty()) WriteColorImage(args.overlay, recognizer.DrawDetections(loaded.rgbd, result.detections));
-    return kExitOk;
+int RecognizeOneFrame(const RecognizeArgs& args, const LoadedFrame& loaded, Recognizer& recognizer) {
+  const RecognitionResult result = recognizer.Recognize(loaded.rgbd);
+  PrintDetections(loaded, result);
+  if (!args.out_json.empty()) WriteJsonFile(args.out_json, RecognitionToJson(result));
+  if (!args.out_bop.empty()) {
+    const auto [scene_id, image_id] = BopIds(args.frame.positional, args.scene_id, args.image_id);
+    std::ostringstream csv;
+    csv << "scene_id,im_id,obj_id,score,R,t,time\n";
+    AppendBopRows(csv, scene_id, image_id, result);
+    WriteFileAtomically(args.out_bop, csv.str());
   }
+  if (!args.overlay.empty()) WriteColorImage(args.overlay, recognizer.DrawDetections(loaded.rgbd, result.detections));
+  return kExitOk;
+}
 
-  // A sequence, processed in order as a camera stream would arrive; a broken frame is reported and skipped.
+// A sequence, processed in order as a camera stream would arrive; a broken frame is reported and skipped.
+int RecognizeSequence(const RecognizeArgs& args, const std::vector<std::string>& frames, Recognizer& recognizer) {
   std::ostringstream lines, csv;
   csv << "scene_id,im_id,obj_id,score,R,t,time\n";
   int failed = 0;
   double total_ms = 0.0;
-  std::vector<Detection> previous;  // the last frame's detections, the priors when tracking
-  size_t full_search = 0;           // the next frame that searches every model (--search-every)
+  RecognitionStream stream(recognizer, args.stream);
   if (!args.overlay.empty()) std::filesystem::create_directories(args.overlay);
   for (size_t i = 0; i < frames.size(); ++i) {
     FrameSpec spec;
@@ -182,14 +168,7 @@ int RunRecognize(const RecognizeArgs& args) {
     try {
       const LoadedFrame loaded = app::LoadFrameWithWarnings(spec);
       const std::pair<int, int> ids = args.out_bop.empty() ? std::pair{-1, -1} : BopIds(frames[i], -1, -1);
-      SearchScope scope = SearchScope::kLostTracks;
-      if (i >= full_search) {
-        scope = SearchScope::kAllModels;
-        full_search = i + static_cast<size_t>(args.search_every);
-      }
-      const RecognitionResult result =
-          args.track ? recognizer.Recognize(loaded.rgbd, previous, scope) : recognizer.Recognize(loaded.rgbd);
-      previous = result.detections;
+      const RecognitionResult result = stream.Next(loaded.rgbd);
       total_ms += result.timings_ms.at("total");
       std::cout << "[" << i + 1 << "/" << frames.size() << "] ";
       PrintDetections(loaded, result);
@@ -204,8 +183,7 @@ int RunRecognize(const RecognizeArgs& args) {
       }
     } catch (const InputError& error) {
       ++failed;
-      previous.clear();
-      full_search = i + 1;  // the priors are lost: the next frame searches every model
+      stream.Reset();  // the priors are lost: the next frame searches every model
       std::cerr << "recognize: frame " << frames[i] << " skipped: " << error.what() << '\n';
       lines << nlohmann::json{{"frame", frames[i]}, {"error", error.what()}}.dump() << '\n';
     }
@@ -215,35 +193,32 @@ int RunRecognize(const RecognizeArgs& args) {
             << (total_ms > 0.0 ? 1000.0 * static_cast<double>(done) / total_ms : 0.0) << " frames per second)";
   if (failed > 0) std::cout << ", " << failed << " failed";
   std::cout << '\n';
-  if (!args.out_json.empty()) WriteTextAtomically(args.out_json, lines.str());
-  if (!args.out_bop.empty()) WriteTextAtomically(args.out_bop, csv.str());
+  if (!args.out_json.empty()) WriteFileAtomically(args.out_json, lines.str());
+  if (!args.out_bop.empty()) WriteFileAtomically(args.out_bop, csv.str());
   return failed > 0 ? kExitBadInput : kExitOk;
 }
 
-}  // namespace
+int RunRecognize(const RecognizeArgs& args) {
+  const RecognizerOptions options = OptionsFromArgs(args);
+  std::vector<std::string> frames;
+  if (!args.sequence.empty()) frames = ListSequenceFrames(args.sequence);
+  // One frame is read first: a broken one is reported before the library and its meshes (seconds) are loaded.
+  std::optional<LoadedFrame> single;
+  if (frames.empty()) single.emplace(app::LoadFrameWithWarnings(args.frame));
+  LibraryLoadOptions load;
+  load.names = args.models;
+  load.build_matchers = false;  // the scene is indexed, the views are queried
+  const ModelLibrary library = ModelLibrary::Load(args.db, load);
+  std::cerr << "recognize: " << library.models().size() << " models, " << library.NumViews() << " views from "
+            << args.db << " (" << std::fixed << std::setprecision(0) << library.timings().read_ms << " ms)\n";
+  const Clock::time_point setup = Clock::now();
+  Recognizer recognizer(library, options);
+  ReportSetup(library, options, MillisecondsSince(setup));
+  return single ? RecognizeOneFrame(args, *single, recognizer) : RecognizeSequence(args, frames, recognizer);
+}
 
-CommandAction SetupRecognizeCommand(CLI::App& command) {
-  auto args = std::make_shared<RecognizeArgs>();
-  command.add_option("--db", args->db, "Model library (SQLite), from `ecvpose modeldb build`")->required();
-  command.add_option("--models", args->models, "Only these models of the library (default: all)");
-  command.add_option("FRAME", args->frame.positional,
-                     "Frame JSON, YCB-Video prefix, BOP SCENE_DIR:IMAGE_ID or organized .pcd (or the frame flags)");
-  AddFrameFlags(command, &args->frame);
-  command.add_option(
-      "--sequence", args->sequence,
-      "Frames in order: a BOP scene folder, a YCB-Video video folder, a directory of frame JSONs, or a file with\n"
-      "one FRAME per line");
-  command.add_option("--out-json", args->out_json,
-                     "Detections as JSON (DESIGN.md: model, score, camera_from_object); JSON Lines for a sequence");
-  command.add_option("--out-bop", args->out_bop,
-                     "Detections as BOP CSV (scene_id,im_id,obj_id,score,R,t,time; t in mm)");
-  command.add_option("--scene-id", args->scene_id, "BOP scene id (default: from the frame name)");
-  command.add_option("--image-id", args->image_id, "BOP image id (default: from the frame name)");
-  command.add_option("--overlay", args->overlay,
-                     "Picture: each detected model in red with its name (PNG); with --sequence a directory,\n"
-                     "one DIR/0001.png ... per frame in sequence order");
-  RecognizerOptions& options = args->options;
-  options.ransac.threads = app::AllCores();
+// The flags of the search: views, models, threads.
+void AddSearchFlags(CLI::App& command, RecognizerOptions& options) {
   command.add_option("--views-per-model", options.views_per_model, "Library views tried with RANSAC per model")
       ->capture_default_str();
   command
@@ -257,18 +232,18 @@ CommandAction SetupRecognizeCommand(CLI::App& command) {
       ->capture_default_str();
   command.add_option("--give-up-score", options.give_up_below_score, "See --give-up-after")->capture_default_str();
   command
-      .add_option("--preselect", options.preselect_models,
-                  "Search only the N models that a quick look at every 4th view (100 descriptors each) scores best, "
-                  "for large libraries (0: every model; 16 YCB-Video models, N = 6: 0.53x the time, 61 instead of "
-                  "68 of 130 objects)")
+      .add_option(
+          "--preselect", options.preselect.models,
+          "Search only the N models that a quick look at every 4th view (100 descriptors each) scores best:\n"
+          "for large libraries, about half the time with 6 of 16 models, at some loss of recall (0: every model)")
       ->capture_default_str();
   command
-      .add_option("--ranking-checks", options.ranking_checks,
+      .add_option("--ranking-checks", options.ranking.checks,
                   "Descriptors compared per query when ranking the library's views (0: as many as matching, 128);\n"
-                  "32 ranks in half the time, less well (bench/RESULTS.md, session 29)")
+                  "32 ranks in half the time, less well")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  command.add_option("--min-score", options.min_score, "Detections below this score are dropped")
+  command.add_option("--min-score", options.verify.min_score, "Detections below this score are dropped")
       ->capture_default_str();
   command
       .add_option("--max-instances", options.max_instances,
@@ -282,31 +257,40 @@ CommandAction SetupRecognizeCommand(CLI::App& command) {
       ->capture_default_str()
       ->check(AtLeastOne());
   command.add_flag(
-      "--no-icp", [&options = args->options](int64_t) { options.refine = false; }, "Skip the ICP refinement");
-  command.add_flag("--track", args->track,
+      "--no-icp", [o = &options](int64_t) { o->refine = false; }, "Skip the ICP refinement");
+}
+
+// The stream flags: tracking objects from frame to frame.
+void AddTrackingFlags(CLI::App& command, RecognizeArgs* args) {
+  command.add_flag("--track", args->stream.track,
                    "With --sequence: try each object first at its pose in the previous frame (refined and verified);\n"
                    "objects tracked so skip view ranking and RANSAC");
   command
-      .add_option("--search-every", args->search_every,
+      .add_option("--search-every", args->stream.search_every,
                   "With --track: models not tracked are searched on every N-th frame only (the first, 1 + N, ...;\n"
                   "after a broken frame, the next); in between, the tracked objects are followed and a lost one is\n"
                   "searched for at once")
       ->capture_default_str();
   command
-      .add_option("--track-start-score", options.min_track_start_score,
+      .add_option("--track-start-score", args->options.tracking.min_start_score,
                   "With --track: a new detection is followed into the next frame only from this score on")
       ->capture_default_str();
+}
+
+// The flags of verification, RANSAC's inliers, matching and ICP.
+void AddVerifyFlags(CLI::App& command, RecognizeArgs* args) {
+  RecognizerOptions& options = args->options;
   command.add_flag(
-      "--no-contour", [&options = args->options](int64_t) { options.contour_falloff = 0.0; },
+      "--no-contour", [o = &options](int64_t) { o->verify.contour_falloff = 0.0; },
       "Verify without the contour factor (a pose's outline on the scene's depth steps): for flat objects thinner\n"
       "than 1 cm lying on a surface, or parts packed flush in a tray");
   command
-      .add_option("--edge-weight", options.edge_weight,
+      .add_option("--edge-weight", options.verify.edge_weight,
                   "Weight of the texture edges against the colour correlation in verification (0: colour alone)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
   command.add_flag(
-      "--nearest-inliers", [&options = args->options](int64_t) { options.projective_inliers = false; },
+      "--nearest-inliers", [o = &options](int64_t) { o->projective_inliers = false; },
       "RANSAC finds an object point's inlier partner by a search among the scene's points in 3D (the paper)\n"
       "instead of among the depth samples around where the point is seen");
   command
@@ -318,6 +302,35 @@ CommandAction SetupRecognizeCommand(CLI::App& command) {
       ->capture_default_str();
   command.add_flag("--fast-icp", options.projective_icp,
                    "ICP pairs points along the camera's rays (7x faster refinement, finds fewer objects)");
+}
+
+}  // namespace
+
+CommandAction SetupRecognizeCommand(CLI::App& command) {
+  auto args = std::make_shared<RecognizeArgs>();
+  AddDbOption(command, &args->db, "Model library (SQLite), from `ecvpose modeldb build`");
+  command.add_option("--models", args->models, "Only these models of the library (default: all)");
+  command.add_option("FRAME", args->frame.positional,
+                     "Frame JSON, YCB-Video prefix, BOP SCENE_DIR:IMAGE_ID or organized .pcd (or the frame flags)");
+  AddFrameFlags(command, &args->frame);
+  command.add_option(
+      "--sequence", args->sequence,
+      "Frames in order: a BOP scene folder, a YCB-Video video folder, a directory of frame JSONs, or a file with\n"
+      "one FRAME per line");
+  command.add_option(
+      "--out-json", args->out_json,
+      "Detections as JSON (model, score, camera_from_object and the verification terms); JSON Lines for a sequence");
+  command.add_option("--out-bop", args->out_bop,
+                     "Detections as BOP CSV (scene_id,im_id,obj_id,score,R,t,time; t in mm)");
+  command.add_option("--scene-id", args->scene_id, "BOP scene id (default: from the frame name)");
+  command.add_option("--image-id", args->image_id, "BOP image id (default: from the frame name)");
+  command.add_option("--overlay", args->overlay,
+                     "Picture: each detected model in red with its name (PNG); with --sequence a directory,\n"
+                     "one DIR/0001.png ... per frame in sequence order");
+  args->options.ransac.threads = app::AllCores();
+  AddSearchFlags(command, args->options);
+  AddTrackingFlags(command, args.get());
+  AddVerifyFlags(command, args.get());
   command.footer(
       "Example:\n  ecvpose modeldb build models/meshes --db lib.sqlite\n"
       "  ecvpose recognize --db lib.sqlite models/frame/000001 --out-json detections.json --overlay detections.png");

@@ -17,8 +17,7 @@ struct ConsistencyOptions {
   /// is within RANSAC's 1 cm, so a true pair's distances differ by up to 2 cm), metres ...
   double tolerance_m = 0.015;
   /// ... and the |cosines| between their orientations, and between each orientation and the line joining
-  /// them, agree within this. On 15 YCB-Video frames, 0.2 found 18 of 35 objects, 0.3 25 and 0.4 25 (with
-  /// fewer false positives).
+  /// them, agree within this (tighter values found fewer objects).
   double angle_tolerance = 0.4;
   double min_distance_m = 0.02;  ///< pairs closer than this say little and are not counted, metres
   double max_distance_m = 1.0;   ///< nor pairs further apart than this (the recognizer: the model diameter)

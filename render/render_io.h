@@ -32,7 +32,7 @@ struct RenderedViewFiles {
 
 /// Writes `<stem>-color.png` (RGB), `<stem>-depth.png` (16-bit, metres * kRenderedDepthScale, 0 =
 /// missing), `<stem>-mask.png` (0/255), with `with_labels` `<stem>-labels.png` (1 + object index; 8-bit
-/// up to 255 objects, else 16-bit), and last `<stem>.json`: a frame JSON as in DESIGN.md ("color",
+/// up to 255 objects, else 16-bit), and last `<stem>.json`: a frame JSON as every command reads ("color",
 /// "depth", "depth_scale", "camera": [fx, fy, cx, cy]) that LoadFrame reads, with "width", "height",
 /// "mask", "depth_unit" and the keys of `extra` (e.g. "camera_from_object"). `depth` replaces the
 /// rendered depth when not empty (a noisy one). Throws InputError when a file cannot be written.

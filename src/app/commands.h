@@ -1,15 +1,23 @@
 #pragma once
 
 #include <functional>
+#include <string>
 
 #include <CLI/CLI.hpp>
 
 namespace ecv::app {
 
-/// Exit codes of every subcommand (DESIGN.md, "Errors").
+/// Exit codes of every subcommand.
 inline constexpr int kExitOk = 0;
 inline constexpr int kExitBadInput = 1;
 inline constexpr int kExitBadUsage = 2;
+
+/// Declares the required `--db LIB` flag, a model library file, on `command`; `description` says what the command
+/// takes from it.
+inline CLI::Option* AddDbOption(CLI::App& command, std::string* db,
+                                const std::string& description = "Model library file (SQLite)") {
+  return command.add_option("--db", *db, description)->required();
+}
 
 /// What a subcommand does once its flags are parsed; returns the exit code.
 using CommandAction = std::function<int()>;

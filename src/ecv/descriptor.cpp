@@ -6,13 +6,13 @@
 #include <memory>
 #include <numeric>
 #include <string>
-#include <thread>
 
 #include <flann/algorithms/dist.h>
 #include <flann/algorithms/kdtree_single_index.h>
 #include <Eigen/Eigenvalues>
 
 #include "core/error.h"
+#include "core/parallel.h"
 
 namespace ecv {
 namespace {
@@ -425,10 +425,7 @@ Descriptors ComputeDescriptors(const std::vector<Primitive>& input, const Descri
       described[s] = 1;
     }
   };
-  std::vector<std::thread> workers;
-  for (int t = 1; t < threads; ++t) workers.emplace_back(work);
-  work();
-  for (std::thread& worker : workers) worker.join();
+  RunOnThreads(threads, work);
 
   std::vector<int> rows;  // of `values`
   for (size_t s = 0; s < sources; ++s) {

@@ -43,10 +43,10 @@ enum class DescriptorShape : int {
   kSurface = 1,
 };
 
-/// The ECV context descriptor (paper Sect. II-B; DESIGN.md "Context descriptor"). Defaults chosen by the
-/// correspondence score on YCB-Video videos 0000 and 0001 (bench/RESULTS.md, ablations); the paper's own
-/// descriptor is soft_binning = false, hellinger = false with the pairs, appearance and weighting below at
-/// their defaults and max_neighbours 0.
+/// The ECV context descriptor (paper Sect. II-B). Defaults chosen by the correspondence score on YCB-Video videos
+/// 0000 and 0001 (bench/RESULTS.md, "Discriminative power of descriptors", ablations); the paper's own descriptor is
+/// soft_binning = false, hellinger = false with the pairs, appearance and weighting below at their defaults and
+/// max_neighbours 0.
 ///
 /// The field defaults below are the paper's context (all pairs of a 2.5 cm ball, one shell) with this
 /// project's soft bins and Hellinger distance; model libraries are built with SourceShells() instead.
@@ -58,10 +58,8 @@ struct DescriptorOptions {
   int max_neighbours = 0;
   /// A segment's direction has no sign: use |cosines| that involve one. A segment's sign follows the image axes
   /// (Primitive::orientation), so signed directions change with the camera's roll about its optical axis and
-  /// unsigned ones do not. Libraries use signed ones: upright / turned 180 degrees, the 30 YCB-Video frames give
-  /// 182 / 145 of 210 objects signed, 171 / 174 unsigned, but unsigned lose the LM-O can (found with 1 of 6 seeds
-  /// instead of 6); build with {"descriptor": {"unsigned_segments": true}} for a camera not held level
-  /// (bench/RESULTS.md, session 32).
+  /// unsigned ones do not; signed ones find more objects of a camera held level, unsigned ones suit a camera that
+  /// is not (bench/RESULTS.md, "the camera's roll").
   bool unsigned_segments = false;
   bool soft_binning = true;  ///< share each value between its two nearest bins (linear)
   bool use_color = true;     ///< false: shape only (the three colour histograms stay zero)
@@ -69,23 +67,18 @@ struct DescriptorOptions {
   /// primitives is 0.5 (beyond the paper: cancels white balance and exposure between views).
   bool balance_colors = false;
   bool hellinger = true;  ///< store square roots of the histogram values (L2 then = Hellinger)
-  /// Which pairs (see the enum). Source pairs alone (2.5 cm, one shell): 11.2 / 11.5 / 3.8 / 60.4 / 43.3 %
-  /// (columns as above; easier to confuse on near views) at 14 instead of 1082 ms per view; with radial
-  /// shells they win every column.
+  /// Which pairs (see the enum). Source pairs cost a small fraction of all pairs' time; with radial shells they
+  /// also describe better.
   DescriptorPairs pairs = DescriptorPairs::kAll;
-  /// Appearance histograms. RGB log ratios and the monogenic ones lost on held-out recognition in every
-  /// form tried (all pairs: 7.8 and 8.4 against 11.1 %; source pairs, 4 shells, 4.5 cm: 16.4 and 14.1
-  /// against 18.5 %), though log ratios gained on the tuning columns (24.5 / 71.4 against 23.2 / 69.5).
+  /// Appearance histograms: RGB differences; the alternatives lost on held-out recognition in every form tried.
   DescriptorAppearance appearance = DescriptorAppearance::kRgbDifference;
   /// Weight of a pair = 1 - closeness_weight * (distance of its farther member from the source) / radius_m,
-  /// in [0, 1]: 0 = every pair counts the same (the paper); 1 = pairs at the rim count nothing. No clear
-  /// effect (all pairs, 0.5: 11.7 / 11.3 / 2.0 / 68.5 / 57.6 %), so 0.
+  /// in [0, 1]: 0 = every pair counts the same (the paper); 1 = pairs at the rim count nothing (no clear effect).
   double closeness_weight = 0.0;
   /// 1: each histogram has 16 bins over its value (the paper). 2 or 4: radial shells of 16 / shells bins
   /// each, by the distance of the pair's farther member from the source (shells of equal area: split at
-  /// radius_m / sqrt 2 for two), so that the histograms also say where the pairs lie (as SHOT's grid does).
-  /// The largest gain measured: with source pairs at 3.5 cm, 1 / 2 / 4 shells give 12.4 / 18.2 / 20.1 %
-  /// on recognition tuning.
+  /// radius_m / sqrt 2 for two), so that the histograms also say where the pairs lie (as SHOT's grid does): the
+  /// largest gain of the ablations.
   int shells = 1;
   /// The shape histograms (see the enum). kSurface needs the views' SurfaceSamples in ComputeDescriptors.
   DescriptorShape shape = DescriptorShape::kPrimitives;
@@ -93,11 +86,9 @@ struct DescriptorOptions {
   double surface_weight = 2.0;
 
   /// The context model libraries are built with (FeatureSettings): pairs of the source with each neighbour
-  /// (kSource) in 4 radial shells over 4.5 cm. discriminative_bench (bench/RESULTS.md, 2026-11-22 06:12), mean
-  /// score recognition tuning / held out / hard / easy tuning / easy held out: 23.2 / 18.5 / 3.5 / 69.5 /
-  /// 60.7 % against 11.9 / 11.1 / 1.7 / 68.3 / 55.3 for the field defaults, and 39 instead of 1082 ms per view.
-  /// End to end on the 30 YCB-Video frames (RANSAC seeds 1/2/3) with the recognizer's surface-fit factor:
-  /// 57 / 55 / 57 of 70 objects against 49 / 47 / 46 (bench/RESULTS.md, session 15).
+  /// (kSource) in 4 radial shells over 4.5 cm. It scores about twice the field defaults' correspondence score at
+  /// 1/27 of their time, and finds more objects end to end (bench/RESULTS.md, "Discriminative power of
+  /// descriptors" and "Recognition on YCB-Video and LM-O").
   static DescriptorOptions SourceShells();
   /// SourceShells() with the surface context for its shape histograms (DescriptorShape::kSurface).
   static DescriptorOptions SurfaceShells();

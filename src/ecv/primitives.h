@@ -72,7 +72,7 @@ struct ExtractionResult {
   ExtractionTimings timings;
 };
 
-/// ECV primitives of an RGB-D frame (paper Sect. II-A; DESIGN.md "ECV primitives"): monogenic signal,
+/// ECV primitives of an RGB-D frame (paper Sect. II-A): monogenic signal,
 /// hexagonal grid, intrinsic-dimensionality classification and 3D reconstruction from the depth image.
 /// `mask` (CV_8UC1, optional) restricts keypoints to non-zero pixels.
 ExtractionResult ExtractPrimitives(const RgbdFrame& frame, const EcvOptions& options = {}, const cv::Mat& mask = {});

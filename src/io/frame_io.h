@@ -10,7 +10,7 @@
 
 namespace ecv {
 
-/// How a command names one frame (DESIGN.md, "Interfaces shared by every subcommand"): either one
+/// How a command names one frame: either one
 /// positional FRAME, or the flags --color, --depth, --depth-scale and --camera.
 struct FrameSpec {
   /// A frame JSON, a YCB-Video prefix (".../0001/000001"), a BOP image "SCENE_DIR:IMAGE_ID" or an

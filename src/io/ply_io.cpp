@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "io/atomic_file.h"
 
 namespace ecv {
 namespace {
@@ -22,10 +23,8 @@ unsigned char ColorByte(float value) {
 }  // namespace
 
 void WritePrimitivesPly(const std::string& path, const std::vector<Primitive>& primitives) {
-  const std::string temporary = path + ".tmp";
+  std::ostringstream stream(std::ios::binary);
   {
-    std::ofstream stream(temporary, std::ios::binary);
-    if (!stream) ThrowInputError(path, "output", "a writable location");
     stream << "ply\nformat binary_little_endian 1.0\ncomment ecvpose ECV primitives (metres)\n"
            << "element vertex " << primitives.size() << '\n'
            << "property float x\nproperty float y\nproperty float z\n"
@@ -42,11 +41,8 @@ void WritePrimitivesPly(const std::string& path, const std::vector<Primitive>& p
       tail[3] = static_cast<unsigned char>(primitive.type);
       stream.write(record, kRecordSize);
     }
-    if (!stream.flush()) ThrowInputError(path, "output", "a writable location with free space");
   }
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) ThrowInputError(path, "output", "a writable location", error.message());
+  WriteFileAtomically(path, stream.str());
 }
 
 std::vector<Primitive> ReadPrimitivesPly(const std::string& path) {

@@ -5,6 +5,7 @@
 
 #include "core/error.h"
 #include "core/pose.h"
+#include "io/atomic_file.h"
 
 namespace ecv {
 
@@ -54,16 +55,7 @@ nlohmann::json ReadJsonFile(const std::string& path) {
 }
 
 void WriteJsonFile(const std::string& path, const nlohmann::json& value) {
-  const std::string temporary = path + ".tmp";
-  {
-    std::ofstream stream(temporary);
-    if (!stream) ThrowInputError(path, "output", "a writable location");
-    stream << value.dump(2) << '\n';
-    if (!stream.flush()) ThrowInputError(path, "output", "a writable location with free space");
-  }
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) ThrowInputError(path, "output", "a writable location", error.message());
+  WriteFileAtomically(path, value.dump(2) + "\n");
 }
 
 }  // namespace ecv

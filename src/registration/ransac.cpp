@@ -9,11 +9,11 @@
 #include <numeric>
 #include <random>
 #include <string>
-#include <thread>
 
 #include <Eigen/Geometry>
 
 #include "core/error.h"
+#include "core/parallel.h"
 #include "core/point_index.h"
 
 namespace ecv {
@@ -434,10 +434,7 @@ RansacResult Estimate(const std::vector<Eigen::Vector3f>& object_points,
       }
     }
   };
-  std::vector<std::thread> workers;
-  for (int t = 1; t < std::min(options.threads, blocks); ++t) workers.emplace_back(work);
-  work();
-  for (std::thread& worker : workers) worker.join();
+  RunOnThreads(std::min(options.threads, blocks), work);
 
   Estimator::Best best;
   const int last_block = std::min(stop_block.load(), blocks - 1);

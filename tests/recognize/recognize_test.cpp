@@ -143,7 +143,7 @@ TEST_F(RecognizeEndToEnd, FindsTheObjectsOfTheDemoFrameWithinTenthOfTheirDiamete
 
 // The speed options: exact matching over 7-bit descriptors (plain loop or VNNI, the same matches) and view ranking
 // with fewer checks still find the demo frame's three objects; an unknown matcher is named.
-// Pre-selection (RecognizerOptions::preselect_models): of the three models, all in the frame, exactly the two
+// Pre-selection (PreselectOptions::models): of the three models, all in the frame, exactly the two
 // kept are searched, both found at their true poses and nothing else reported; keeping as many as there are
 // models changes nothing. A negative count is refused, naming the option.
 TEST_F(RecognizeEndToEnd, PreselectionSearchesOnlyTheBestScoringModels) {
@@ -151,7 +151,7 @@ TEST_F(RecognizeEndToEnd, PreselectionSearchesOnlyTheBestScoringModels) {
   const ModelLibrary library = Library();
   const std::vector<EvalModel> models = EvalModels(library);
   RecognizerOptions options;
-  options.preselect_models = 2;
+  options.preselect.models = 2;
   Recognizer preselecting(library, options);
   const RecognitionResult kept = preselecting.Recognize(frame.rgbd);
   EXPECT_EQ(kept.views_tried.size(), 2U);
@@ -164,7 +164,7 @@ TEST_F(RecognizeEndToEnd, PreselectionSearchesOnlyTheBestScoringModels) {
     EXPECT_EQ(object.correct, searched) << object.model;
   }
 
-  options.preselect_models = 3;
+  options.preselect.models = 3;
   const RecognitionResult all = Recognizer(library, options).Recognize(frame.rgbd);
   const RecognitionResult plain = Recognizer(library).Recognize(frame.rgbd);
   EXPECT_EQ(all.views_tried, plain.views_tried);
@@ -177,7 +177,7 @@ TEST_F(RecognizeEndToEnd, PreselectionSearchesOnlyTheBestScoringModels) {
 
   const test::CommandResult bad = test::RunCli("recognize --db " + library_ + " " + Frame() + " --preselect -1");
   EXPECT_NE(bad.exit_code, 0);
-  EXPECT_NE(bad.output.find("preselect_models"), std::string::npos) << bad.output;
+  EXPECT_NE(bad.output.find("preselect.models"), std::string::npos) << bad.output;
 }
 
 TEST_F(RecognizeEndToEnd, TheBytesMatcherAndFewerRankingChecksFindTheDemoFramesObjects) {
@@ -219,7 +219,7 @@ TEST_F(RecognizeEndToEnd, RankViewsListsEveryViewBestFirstAndRanksARightViewFirs
     ASSERT_EQ(views.size(), model.record.views.size()) << model.record.name;
     for (size_t i = 1; i < views.size(); ++i) EXPECT_GE(views[i - 1].score, views[i].score) << model.record.name;
     for (const RankedView& view : views) {
-      EXPECT_LE(view.correspondences.size(), static_cast<size_t>(RecognizerOptions().consistency_max_correspondences));
+      EXPECT_LE(view.correspondences.size(), static_cast<size_t>(RecognizerOptions().ranking.max_correspondences));
     }
   }
   const GroundTruth* truth = TruthOf(frame, "003_cracker_box");
@@ -319,7 +319,7 @@ TEST_F(RecognizeEndToEnd, AFirstDetectionBelowTheTrackStartScoreIsNotFollowed) {
   RecognizerOptions options;
   std::vector<Detection> priors = Recognizer(library, options).Recognize(frame.rgbd).detections;
   ASSERT_EQ(priors.size(), 1U);
-  options.min_track_start_score = std::min(1.0, priors[0].score + 0.01);
+  options.tracking.min_start_score = std::min(1.0, priors[0].score + 0.01);
   Recognizer recognizer(library, options);
   const RecognitionResult fresh = recognizer.Recognize(frame.rgbd, priors);  // a first appearance, below the bar
   ASSERT_EQ(fresh.detections.size(), 1U);
@@ -381,22 +381,22 @@ TEST_F(RecognizeEndToEnd, APoseAFewMillimetresOffTheSurfaceScoresZeroThroughItsR
   ASSERT_NE(truth, nullptr);
   RecognizerOptions options;
   options.refine = false;  // verified at the prior's pose as it is
-  options.min_score = 0.0;
-  options.min_visible_fraction = 0.0;
+  options.verify.min_score = 0.0;
+  options.verify.min_visible_fraction = 0.0;
   auto verify = [&](const RecognizerOptions& settings, const Eigen::Isometry3d& pose) {
     return test::VerifyPrior(library, settings, frame.rgbd, "003_cracker_box", pose);
   };
   const Detection right = verify(options, truth->camera_from_object);
-  EXPECT_LT(right.surface_error_m, options.residual_free_m);
+  EXPECT_LT(right.surface_error_m, options.verify.residual_free_m);
   EXPECT_GT(right.score, 0.3);
 
   Eigen::Isometry3d back = truth->camera_from_object;
   back.translation() += 0.009 * back.translation().normalized();
   const Detection off = verify(options, back);
   EXPECT_GT(off.depth_agreement, 0.8);
-  EXPECT_GT(off.surface_error_m, options.residual_free_m + options.residual_falloff_m);
+  EXPECT_GT(off.surface_error_m, options.verify.residual_free_m + options.verify.residual_falloff_m);
   EXPECT_EQ(off.score, 0.0);
-  options.residual_falloff_m = 0.0;  // no factor: depth agreement and colour alone pass it
+  options.verify.residual_falloff_m = 0.0;  // no factor: depth agreement and colour alone pass it
   EXPECT_GT(verify(options, back).score, 0.3);
 }
 
@@ -530,10 +530,10 @@ TEST(RecognizerOptions, OutOfRangeValuesAreReportedByName) {
   options.icp_max_points = -1;
   EXPECT_NE(message(options).find("icp_max_points"), std::string::npos) << message(options);
   options = RecognizerOptions();
-  options.min_score = 1.5;
+  options.verify.min_score = 1.5;
   EXPECT_NE(message(options).find("min_score"), std::string::npos) << message(options);
   options = RecognizerOptions();
-  options.residual_falloff_m = -0.001;
+  options.verify.residual_falloff_m = -0.001;
   EXPECT_NE(message(options).find("residual_falloff_m"), std::string::npos) << message(options);
   options = RecognizerOptions();
   options.max_instances = 0;
@@ -542,7 +542,7 @@ TEST(RecognizerOptions, OutOfRangeValuesAreReportedByName) {
   options.later_instance_views = -1;
   EXPECT_NE(message(options).find("later_instance_views"), std::string::npos) << message(options);
   options = RecognizerOptions();
-  options.max_texture_size = 0;
+  options.verify.max_texture_size = 0;
   EXPECT_NE(message(options).find("max_texture_size"), std::string::npos) << message(options);
   options = RecognizerOptions();
   options.good_enough_score = -0.1;
@@ -554,13 +554,13 @@ TEST(RecognizerOptions, OutOfRangeValuesAreReportedByName) {
   options.give_up_below_score = -0.1;
   EXPECT_NE(message(options).find("give_up_below_score"), std::string::npos) << message(options);
   options = RecognizerOptions();
-  options.edge_weight = 1.2;
+  options.verify.edge_weight = 1.2;
   EXPECT_NE(message(options).find("edge_weight"), std::string::npos) << message(options);
   options = RecognizerOptions();
-  options.min_edge_pixels = 0;
+  options.verify.min_edge_pixels = 0;
   EXPECT_NE(message(options).find("min_edge_pixels"), std::string::npos) << message(options);
   options = RecognizerOptions();
-  options.edge.weak = -1.0;
+  options.verify.edge.weak = -1.0;
   EXPECT_NE(message(options).find("weak"), std::string::npos) << message(options);
   options = RecognizerOptions();
   options.rival_min_ratio = -0.5;

@@ -15,6 +15,7 @@
 #include "io/pose_io.h"
 #include "modeldb/model_library.h"
 #include "recognize/evaluation.h"
+#include "recognize/recognition_stream.h"
 #include "recognize/recognizer.h"
 #include "support/test_data.h"
 #include "verify_prior.h"
@@ -130,8 +131,8 @@ TEST_F(YcbvLibrary, TheGelatinBoxLyingOnThePuddingBoxScoresZeroThroughItsOutline
   for (Detection& prior : priors) prior.tracked = true;
 
   RecognizerOptions options;
-  options.min_score = 0.0;  // report every prior with its score
-  options.min_visible_fraction = 0.0;
+  options.verify.min_score = 0.0;  // report every prior with its score
+  options.verify.min_visible_fraction = 0.0;
   options.max_overlap = 1.0;
   auto verified = [&](const RecognizerOptions& settings) {
     std::map<std::string, Detection> by_model;
@@ -142,14 +143,14 @@ TEST_F(YcbvLibrary, TheGelatinBoxLyingOnThePuddingBoxScoresZeroThroughItsOutline
     return by_model;
   };
   std::map<std::string, Detection> scored = verified(options);
-  options.contour_falloff = 0.0;  // no contour factor
+  options.verify.contour_falloff = 0.0;  // no contour factor
   std::map<std::string, Detection> unfactored = verified(options);
   EXPECT_LT(scored["009_gelatin_box"].contour_agreement, 0.15);
   EXPECT_GT(scored["009_gelatin_box"].depth_agreement, 0.9);
   EXPECT_LT(scored["009_gelatin_box"].score, 0.05);
   EXPECT_GT(unfactored["009_gelatin_box"].score, 0.3);  // without the factor it passes
   for (const char* model : {"006_mustard_bottle", "010_potted_meat_can"}) {
-    EXPECT_GT(scored[model].contour_agreement, options.contour_free) << model;
+    EXPECT_GT(scored[model].contour_agreement, options.verify.contour_free) << model;
     EXPECT_GT(scored[model].score, 0.25) << model;
     EXPECT_EQ(scored[model].score, unfactored[model].score) << model;  // a factor of 1
   }
@@ -178,20 +179,20 @@ TEST_F(YcbvLibrary, TheMustardBottleTurnedToItsPrintedSideLosesThroughItsTexture
   ASSERT_GT(RotationAngle(right.camera_from_object, turned), 170.0 * M_PI / 180.0);
 
   RecognizerOptions options;
-  options.min_score = 0.0;  // report the prior with its score
-  options.min_visible_fraction = 0.0;
+  options.verify.min_score = 0.0;  // report the prior with its score
+  options.verify.min_visible_fraction = 0.0;
   auto verified = [&](const RecognizerOptions& settings, const Eigen::Isometry3d& pose) {
     return test::VerifyPrior(library, settings, frame.rgbd, "006_mustard_bottle", pose);
   };
   const Detection right_scored = verified(options, right.camera_from_object);
   const Detection turned_scored = verified(options, turned);
-  EXPECT_GT(right_scored.edge_pixels, options.min_edge_pixels);
+  EXPECT_GT(right_scored.edge_pixels, options.verify.min_edge_pixels);
   EXPECT_GT(turned_scored.edge_pixels, 1.5 * right_scored.edge_pixels);  // the printed side
   EXPECT_GT(right_scored.edge_agreement, turned_scored.edge_agreement + 0.1);
   EXPECT_GT(right_scored.score, turned_scored.score);
   EXPECT_LT(RotationAngle(right_scored.camera_from_object, right.camera_from_object), 10.0 * M_PI / 180.0);
   // Colour alone prefers the turned bottle.
-  options.edge_weight = 0.0;
+  options.verify.edge_weight = 0.0;
   EXPECT_LT(verified(options, right.camera_from_object).score, verified(options, turned).score);
 }
 
@@ -288,6 +289,39 @@ TEST_F(YcbvLibrary, BetweenFullSearchesOnlyTheTracksAreFollowed) {
     EXPECT_EQ(timings.contains("extract"), i == 0) << frames[i] << timings.dump();
     EXPECT_EQ(timings.contains("ransac"), i == 0) << frames[i] << timings.dump();
   }
+}
+
+// The CLI's --track follows the streaming rules of RecognitionStream, which the benchmarks use: the same detections
+// frame by frame (video 0001, a full search every second frame).
+TEST_F(YcbvLibrary, TheCliTracksAsTheRecognitionStreamDoes) {
+  const std::string scenes = test::DataPath("ycbv_subset/Example-Scenes/0001/");
+  const std::vector<std::string> frames = {scenes + "000001", scenes + "000003", scenes + "000005", scenes + "000007"};
+  const std::vector<nlohmann::json> lines = Recognize("stream_cli", "--track --search-every 2 --threads 1", frames);
+  ASSERT_EQ(lines.size(), frames.size());
+  LibraryLoadOptions load;
+  load.build_matchers = false;
+  const ModelLibrary library = ModelLibrary::Load(library_, load);
+  RecognizerOptions options;
+  options.ransac.threads = 1;
+  Recognizer recognizer(library, options);
+  RecognitionStream stream(recognizer, {true, 2});
+  int tracked = 0;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const RecognitionResult result = stream.Next(LoadYcbvFrame(frames[i]).rgbd);
+    const nlohmann::json& cli = lines[i].at("detections");
+    ASSERT_EQ(cli.size(), result.detections.size()) << frames[i] << lines[i].dump();
+    for (size_t d = 0; d < cli.size(); ++d) {
+      const Detection& ours = result.detections[d];
+      EXPECT_EQ(cli[d].at("model").get<std::string>(), ours.model) << frames[i];
+      EXPECT_EQ(cli[d].at("tracked").get<bool>(), ours.tracked) << frames[i] << ours.model;
+      EXPECT_NEAR(cli[d].at("score").get<double>(), ours.score, 1e-12) << frames[i] << ours.model;
+      const Eigen::Isometry3d pose = PoseFromJson(cli[d].at("camera_from_object"), frames[i], "camera_from_object");
+      EXPECT_LT((pose.matrix() - ours.camera_from_object.matrix()).cwiseAbs().maxCoeff(), 1e-9) << frames[i];
+      tracked += ours.tracked ? 1 : 0;
+    }
+    EXPECT_EQ(lines[i].at("timings_ms").contains("extract"), i % 2 == 0) << frames[i];  // full searches: 1 and 3
+  }
+  EXPECT_GE(tracked, 6);  // frames 2-4 follow the three objects
 }
 
 TEST_F(YcbvLibrary, BrokenFrameInSequenceIsReportedAndTheOthersAreProcessed) {

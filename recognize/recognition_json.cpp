@@ -1,0 +1,51 @@
+#include "recognize/recognizer.h"
+
+#include "core/error.h"
+#include "io/pose_io.h"
+
+namespace ecv {
+
+nlohmann::json RecognitionToJson(const RecognitionResult& result) {
+  nlohmann::json detections = nlohmann::json::array();
+  for (const Detection& d : result.detections) {
+    detections.push_back({{"model", d.model},
+                          {"score", d.score},
+                          {"camera_from_object", PoseToJson(d.camera_from_object)},
+                          {"inlier_fraction", d.inlier_fraction},
+                          {"fit_error", d.fit_error_m},
+                          {"view", d.view},
+                          {"depth_agreement", d.depth_agreement},
+                          {"color_agreement", d.color_agreement},
+                          {"visible_fraction", d.visible_fraction},
+                          {"surface_error", d.surface_error_m},
+                          {"contour_agreement", d.contour_agreement},
+                          {"edge_agreement", d.edge_agreement},
+                          {"edge_pixels", d.edge_pixels},
+                          {"tracked", d.tracked}});
+  }
+  return {{"detections", detections},
+          {"timings_ms", result.timings_ms},
+          {"scene_primitives", result.scene_primitives},
+          {"views_tried", result.views_tried}};
+}
+
+std::vector<Detection> DetectionsFromJson(const nlohmann::json& json, const std::string& source) {
+  if (!json.contains("detections") || !json["detections"].is_array()) {
+    ThrowInputError(source, "detections", "an array of detections (ecvpose recognize --out-json)");
+  }
+  std::vector<Detection> detections;
+  for (size_t i = 0; i < json["detections"].size(); ++i) {
+    const nlohmann::json& item = json["detections"][i];
+    const std::string field = "detections[" + std::to_string(i) + "]";
+    if (!item.contains("model") || !item["model"].is_string()) ThrowInputError(source, field + ".model", "a string");
+    Detection detection;
+    detection.model = item["model"].get<std::string>();
+    detection.camera_from_object =
+        PoseFromJson(item.value("camera_from_object", nlohmann::json()), source, field + ".camera_from_object");
+    detection.score = item.value("score", 0.0);
+    detections.push_back(detection);
+  }
+  return detections;
+}
+
+}  // namespace ecv

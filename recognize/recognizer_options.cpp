@@ -1,0 +1,62 @@
+#include "recognize/recognizer_options.h"
+
+#include "core/error.h"
+
+namespace ecv {
+
+RansacOptions RecognizerOptions::DefaultRansac() {
+  RansacOptions options;           // the paper's numbers, but:
+  options.adaptive = true;         // stop once the best pose shows the sampled views are easy
+  options.prefer_agreeing = true;  // rank poses by agreeing (appearance-bearing) correspondences
+  options.max_iterations = 10000;  // fewer samples per view, spent on more views
+  // A sample's pose is counted only when one correspondence in a hundred (at least one) agrees with it besides the
+  // sample: most wrong samples are agreed with by their own three alone.
+  options.min_support = 1;
+  options.min_support_share = 0.01;
+  return options;
+}
+
+MatchOptions RecognizerOptions::DefaultMatch() {
+  MatchOptions options;
+  options.exact_below = 100;  // a frame's ~1000 segments are faster in the kd-trees than searched linearly
+  // Randomised kd-trees with small leaves and more checks: nearer neighbours than FLANN's defaults in less time
+  // (bench/RESULTS.md, matching_bench).
+  options.index = MatchIndex::kKdForest;
+  options.trees = 4;
+  options.leaf_size = 8;
+  options.checks = 128;
+  return options;
+}
+
+void RecognizerOptions::Check() const {
+  match.Check();
+  ransac.Check();
+  icp.Check();
+  verify.Check();
+  ranking.consistency.Check();
+  auto require = [](bool ok, const char* field, const char* expected) {
+    if (!ok) ThrowInputError("recognizer options", field, expected);
+  };
+  require(ranking.max_correspondences >= 3, "ranking.max_correspondences", "at least 3");
+  require(ranking.checks >= 0, "ranking.checks", "0 (match.checks) or more");
+  require(preselect.models >= 0, "preselect.models", ">= 0 (0: search every model)");
+  require(preselect.view_stride >= 1, "preselect.view_stride", "at least 1");
+  require(preselect.rows >= 3, "preselect.rows", "at least 3");
+  require(tracking.min_start_score >= 0.0 && tracking.min_start_score <= 1.0, "tracking.min_start_score", "in [0, 1]");
+  require(views_per_model >= 1, "views_per_model", "at least 1");
+  require(good_enough_score >= 0.0, "good_enough_score", ">= 0 (0: try every ranked view)");
+  require(give_up_after_views >= 0, "give_up_after_views", ">= 0 (0: never give up)");
+  require(give_up_below_score >= 0.0, "give_up_below_score", ">= 0");
+  require(rival_min_ratio >= 0.0 && rival_min_ratio <= 1.0, "rival_min_ratio", "in [0, 1] (0: no rival refined)");
+  require(scene_max_neighbours >= 0, "scene_max_neighbours", ">= 0 (0: the library's setting)");
+  require(scene_max_descriptors >= 0, "scene_max_descriptors", ">= 0 (0: every primitive)");
+  require(sample_radius_diameters >= 0.0, "sample_radius_diameters", ">= 0 (0: sample anywhere)");
+  require(dense_stride_px >= 1, "dense_stride_px", "at least 1");
+  require(ransac_stride_px >= 1, "ransac_stride_px", "at least 1");
+  require(icp_max_points >= 0, "icp_max_points", ">= 0 (0: all)");
+  require(max_overlap >= 0.0 && max_overlap <= 1.0, "max_overlap", "in [0, 1]");
+  require(max_instances >= 1, "max_instances", "at least 1");
+  require(later_instance_views >= 0, "later_instance_views", ">= 0 (0: views_per_model)");
+}
+
+}  // namespace ecv

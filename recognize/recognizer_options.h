@@ -1,0 +1,104 @@
+#pragma once
+
+#include "ecv/matching.h"
+#include "recognize/scoring.h"
+#include "recognize/verification.h"
+#include "registration/icp.h"
+#include "registration/ransac.h"
+
+namespace ecv {
+
+/// View ranking: a model's library views ordered by the largest pairwise-consistent set among their
+/// object-to-scene correspondences (ConsistentSetSize), best first; RANSAC tries them in that order.
+struct RankingOptions {
+  /// When two correspondences agree; max_distance_m is set to each model's diameter.
+  ConsistencyOptions consistency;
+  /// Per view, at most this many of its descriptors (a seeded random subset) are matched for the ranking.
+  int max_correspondences = 200;
+  /// Descriptors compared per ranking query (0: MatchOptions::checks). Fewer rank faster and less well.
+  int checks = 0;
+};
+
+/// Pre-selection of candidate models, for large libraries: each model gets a quick score, the largest consistent
+/// set over every view_stride-th view on `rows` of its ranking descriptors, and only the best `models` are searched.
+struct PreselectOptions {
+  int models = 0;  ///< models searched per frame (0: every model; tracked models are not counted)
+  int view_stride = 4;
+  int rows = 100;
+};
+
+/// Tracking between the frames of a stream (Recognizer::Recognize with priors).
+struct TrackingOptions {
+  /// A prior that was not itself tracked (a first detection) is followed only from this score on; once followed,
+  /// it is kept while it verifies (VerifyOptions::min_score). A false detection near min_score then shows in one
+  /// frame instead of persisting along the stream.
+  double min_start_score = 0.35;
+};
+
+/// Settings of the online recognizer (paper Sect. III and IV-C, and what goes beyond it). bench/RESULTS.md,
+/// "Recognizer defaults", gives the measurements behind each default.
+struct RecognizerOptions {
+  MatchOptions match = DefaultMatch();
+  /// RANSAC per model view: the paper's test (t_poly 0.25, eps 1 cm, 50 % of the visible object points). Its
+  /// `threads` are the Recognizer's workers: they describe the scene and then take a model each; the detections
+  /// do not depend on the count.
+  RansacOptions ransac = DefaultRansac();
+  RankingOptions ranking;
+  PreselectOptions preselect;
+  VerifyOptions verify;
+  TrackingOptions tracking;
+
+  /// Views per model tried with RANSAC, the best ranked first.
+  int views_per_model = 10;
+  /// A model's remaining views are not tried once one verifies at this score (0: try views_per_model).
+  double good_enough_score = 0.5;
+  /// A model whose first give_up_after_views views all verify below give_up_below_score is taken to be absent:
+  /// its remaining views are not tried (0: never give up). Not applied to a model's later instances.
+  int give_up_after_views = 4;
+  double give_up_below_score = 0.1;
+  /// Beyond the best verified pose of a model, its best pose turned more than 90 degrees from it is refined and
+  /// verified too when it scored at least this share of the best (0: never): coarse poses of a bottle's front and
+  /// back score alike before ICP, and which one is refined decides.
+  double rival_min_ratio = 0.7;
+  /// The scene's contexts take at most this many neighbours when the library's setting allows more (0: the
+  /// library's): pairs grow with its square, so it bounds the describe time of close-ups.
+  int scene_max_neighbours = 128;
+  /// A scene with more primitives describes only every n-th of them (the smallest n that keeps the sources at or
+  /// under this); all of them still form the contexts. 0: every primitive.
+  int scene_max_descriptors = 8000;
+  /// A RANSAC sample's later correspondences are drawn within this many model diameters of its first one
+  /// (RansacOptions::sample_radius_m); 0 draws them anywhere.
+  double sample_radius_diameters = 1.0;
+  int dense_stride_px = 2;   ///< scene depth points for ICP and verification: every n-th pixel
+  int ransac_stride_px = 4;  ///< scene depth samples for RANSAC's inlier count: every n-th pixel
+  /// RANSAC looks for an object point's inlier partner among the 3 x 3 depth samples around the pixel it projects
+  /// to (RansacOptions::projective_stride_px) instead of the nearest scene point in 3D.
+  bool projective_inliers = true;
+  bool refine = true;  ///< point-to-plane ICP of accepted poses against the scene
+  /// ICP takes the model's surface as rendered at the pose (every dense_stride_px-th pixel), at most this many
+  /// points of it (every n-th; 0: all).
+  int icp_max_points = 3000;
+  IcpOptions icp;
+  /// ICP pairs each model point with the scene sample it projects to (7x faster, narrower basin) instead of the
+  /// nearest scene point in 3D.
+  bool projective_icp = false;
+  /// A detection whose surface pixels lie for more than this share on pixels that a better detection of another
+  /// model explains is dropped (one surface, one object); a model's later instances likewise against its earlier.
+  double max_overlap = 0.3;
+  /// Instances of one model looked for per frame (e.g. a bin of identical parts); 1: the best pose only.
+  int max_instances = 1;
+  /// Views tried for each instance after a model's first: it is known to be in the frame (0: views_per_model).
+  int later_instance_views = 21;
+
+  /// The paper's RANSAC with adaptive stopping, poses ranked by agreeing correspondences, at most 10 000 samples
+  /// per view, and a sample counted only when 1 % of the correspondences (at least 1) agree with it.
+  static RansacOptions DefaultRansac();
+  /// ecvpose's KdForest (4 trees, leaves of 8, 128 checks), approximate from 100 train descriptors on.
+  static MatchOptions DefaultMatch();
+  /// Throws InputError on values outside their ranges.
+  void Check() const;
+  /// Compared descriptors per view-ranking query: ranking.checks, or match.checks when it is 0.
+  int RankingChecks() const { return ranking.checks > 0 ? ranking.checks : match.checks; }
+};
+
+}  // namespace ecv
