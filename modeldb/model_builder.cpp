@@ -20,6 +20,8 @@
 namespace ecv {
 namespace {
 
+constexpr double kMinDiameterM = 0.001, kMaxDiameterM = 10.0;  // what an RGB-D camera can recognise
+
 // Removes an uploaded mesh from the renderer however the build ends.
 class UploadedMesh {
  public:
@@ -144,12 +146,22 @@ BuildResult BuildModel(const ModelSource& source, const ModelBuildOptions& optio
   record.unit = source.unit;
   record.object_from_mesh = source.object_from_mesh;
   record.diameter_m = mesh.Diameter();
+  if (!(record.diameter_m >= kMinDiameterM && record.diameter_m <= kMaxDiameterM)) {
+    ThrowInputError(source.mesh_path, "size",
+                    "an object between 1 mm and 10 m across (is --unit, here '" + source.unit + "', right?)",
+                    std::to_string(record.diameter_m) + " m across");
+  }
   record.symmetric = source.symmetric;
   ModelBuildOptions shaded = options;
   shaded.render.shading = ViewShading(mesh, options);
   record.build_options_json = BuildOptionsToJson(shaded);
   record.features = options.features;
   record.views = BuildModelViews(mesh, shaded, renderer, progress, &result.timings);
+  if (record.NumPrimitives() == 0) {
+    ThrowInputError(source.mesh_path, "views", "ECV primitives in its rendered views",
+                    "none in any of " + std::to_string(record.views.size()) + " views (the mesh is " +
+                        std::to_string(record.diameter_m) + " m across; is --unit right?)");
+  }
   return result;
 }
 

@@ -5,6 +5,8 @@
 #include "modeldb/schema.h"
 
 #include <algorithm>
+#include <cstdio>
+#include <tuple>
 
 #include "core/error.h"
 #include "core/version.h"
@@ -260,6 +262,20 @@ std::string StoredDescriptorSha256(SqlConnection& connection, int64_t model_id) 
   return hash.HexDigest();
 }
 
+namespace {
+
+// True when version `a` ("MAJOR.MINOR.PATCH") is later than `b`; versions that do not parse are not later.
+bool LaterVersion(const std::string& a, const std::string& b) {
+  int a1 = 0, a2 = 0, a3 = 0, b1 = 0, b2 = 0, b3 = 0;
+  if (std::sscanf(a.c_str(), "%d.%d.%d", &a1, &a2, &a3) != 3 ||
+      std::sscanf(b.c_str(), "%d.%d.%d", &b1, &b2, &b3) != 3) {
+    return false;
+  }
+  return std::tie(a1, a2, a3) > std::tie(b1, b2, b3);
+}
+
+}  // namespace
+
 std::string SchemaRefusal(const std::string& path, const SchemaState& state) {
   const std::string current = std::to_string(kModelDbSchemaVersion);
   switch (state.kind) {
@@ -270,8 +286,8 @@ std::string SchemaRefusal(const std::string& path, const SchemaState& state) {
     case SchemaState::Kind::kNewer:
       return path + ": model library of schema version " + std::to_string(state.version) + "; this ecvpose (" +
              kVersion + ") reads versions up to " + current + ": use ecvpose " +
-             (state.newer_needs_ecvpose.empty() ? std::string("of a newer release")
-                                                : state.newer_needs_ecvpose + " or newer");
+             (LaterVersion(state.newer_needs_ecvpose, kVersion) ? state.newer_needs_ecvpose + " or newer"
+                                                                : std::string("of a newer release"));
     case SchemaState::Kind::kForeign:
       return path + ": not an ecvpose model library (an SQLite database with " + state.detail + ")";
     case SchemaState::Kind::kEmpty: return path + ": not an ecvpose model library (an empty database)";

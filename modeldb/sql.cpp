@@ -7,7 +7,10 @@
 
 #include <unistd.h>
 
+#include <chrono>
+#include <cstdio>
 #include <filesystem>
+#include <thread>
 #include <utility>
 
 namespace ecv {
@@ -56,6 +59,26 @@ struct SqlConnection::Impl {
   std::string path;
   sqlite3* db = nullptr;
   bool immutable = false;
+  int lock_timeout_ms = 0;
+  std::chrono::steady_clock::time_point busy_since;
+  bool said_waiting = false;
+
+  // SQLite's busy handler: waits in steps of 20 ms up to lock_timeout_ms for another process's lock, and says once
+  // (after a second) what it is waiting for, so that a writer queued behind another does not look hung.
+  static int WaitForLock(void* self, int count) {
+    auto* impl = static_cast<Impl*>(self);
+    const auto now = std::chrono::steady_clock::now();
+    if (count == 0) impl->busy_since = now;
+    const auto waited = std::chrono::duration_cast<std::chrono::milliseconds>(now - impl->busy_since).count();
+    if (waited >= impl->lock_timeout_ms) return 0;
+    if (waited >= 1000 && !impl->said_waiting) {
+      impl->said_waiting = true;
+      std::fprintf(stderr, "ecvpose: %s: waiting for the library's lock, held by another process (up to %d s)\n",
+                   impl->path.c_str(), impl->lock_timeout_ms / 1000);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    return 1;
+  }
 
   ~Impl() { Close(); }
   void Close() {
@@ -73,7 +96,8 @@ struct SqlConnection::Impl {
     const int code = sqlite3_open_v2(name.c_str(), &db, flags | SQLITE_OPEN_URI, nullptr);
     if (code != SQLITE_OK) Fail(code, "cannot open");
     sqlite3_extended_result_codes(db, 1);
-    sqlite3_busy_timeout(db, busy_timeout_ms);
+    lock_timeout_ms = busy_timeout_ms;
+    sqlite3_busy_handler(db, &Impl::WaitForLock, this);
   }
 
   // Reads the header, so that a file that is not a database fails here rather than at the first query.
@@ -84,6 +108,9 @@ SqlConnection::SqlConnection(const std::string& path, SqlOpenMode mode, int busy
     : impl_(std::make_unique<Impl>()) {
   impl_->path = path;
   const bool memory = path == ":memory:";
+  if (!memory && std::filesystem::is_directory(path)) {
+    throw SqlError(path + ": is a directory, not a model library file", SqlErrorKind::kCannotOpen);
+  }
   if (mode != SqlOpenMode::kCreate && !memory && !std::filesystem::is_regular_file(path)) {
     throw SqlError(path + ": no such file", SqlErrorKind::kCannotOpen);
   }
@@ -101,6 +128,15 @@ SqlConnection::SqlConnection(const std::string& path, SqlOpenMode mode, int busy
     code = impl_->Probe();
   }
   if (code != SQLITE_OK) impl_->Fail(code, "cannot read");
+  // A writer checks at once that it can take the write lock (e.g. no stale read-only -shm file beside the library),
+  // rather than after the work whose result it would store.
+  if (mode != SqlOpenMode::kReadOnly && !memory) {
+    code = sqlite3_exec(impl_->db, "BEGIN IMMEDIATE; ROLLBACK", nullptr, nullptr, nullptr);
+    if (code != SQLITE_OK) {
+      RollbackIfActive();
+      impl_->Fail(code, "cannot write");
+    }
+  }
 }
 
 SqlConnection::~SqlConnection() = default;

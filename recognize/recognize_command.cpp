@@ -209,6 +209,10 @@ int RunRecognize(const RecognizeArgs& args) {
   load.names = args.models;
   load.build_matchers = false;  // the scene is indexed, the views are queried
   const ModelLibrary library = ModelLibrary::Load(args.db, load);
+  if (library.models().empty()) {
+    ThrowInputError(args.db, "models", "a library with at least one model (ecvpose modeldb build MESH --db LIB)",
+                    "none");
+  }
   std::cerr << "recognize: " << library.models().size() << " models, " << library.NumViews() << " views from "
             << args.db << " (" << std::fixed << std::setprecision(0) << library.timings().read_ms << " ms)\n";
   const Clock::time_point setup = Clock::now();

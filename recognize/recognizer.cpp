@@ -52,6 +52,7 @@ class Recognizer::Impl {
  public:
   Impl(const ModelLibrary& library, const RecognizerOptions& options)
       : library_(library), options_(options), renderer_(VerificationRenderer(options)) {
+    if (library.models().empty()) ThrowInputError("model library", "models", "at least one model", "none");
     options_.match.k = 1;
     const std::vector<LibraryModel>& models = library_.models();
     records_.resize(models.size());

@@ -1,7 +1,10 @@
 // ecvpose: one command-line tool, a table of subcommands. Each reads its flags into options and calls
 // one library function; only this file turns exceptions into exit codes.
 
+#include <algorithm>
 #include <iostream>
+#include <iterator>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -49,6 +52,15 @@ int main(int argc, char** argv) {
 
   if (argc <= 1) {
     std::cout << app.help();
+    return ecv::app::kExitBadUsage;
+  }
+  const std::string first = argv[1];
+  const bool known = std::any_of(std::begin(kSubcommands), std::end(kSubcommands),
+                                 [&](const Subcommand& subcommand) { return first == subcommand.name; });
+  if (!known && first.rfind('-', 0) != 0) {
+    std::cerr << "ecvpose: unknown subcommand '" << first << "'; the subcommands are:";
+    for (const Subcommand& subcommand : kSubcommands) std::cerr << ' ' << subcommand.name;
+    std::cerr << " (`ecvpose --help` describes them)\n";
     return ecv::app::kExitBadUsage;
   }
   try {

@@ -2,9 +2,15 @@
 
 #include "io/mesh_io.h"
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -18,6 +24,8 @@
 #include "core/error.h"
 #include "core/pose.h"
 #include "io/frame_io.h"
+#include "io/mesh_blob.h"
+#include "io/ply_check.h"
 
 namespace ecv {
 namespace fs = std::filesystem;
@@ -49,15 +57,11 @@ cv::Mat DecodeEmbedded(const aiTexture& texture) {
   return rgb;
 }
 
-void LoadTexture(const aiScene& scene, const fs::path& mesh_dir, const std::string& mesh_path,
-                 const MeshLoadOptions& options, MeshMaterial* material, std::vector<std::string>* warnings) {
+// Reads a material's texture file, named relative to the mesh's folder; a missing file is an error unless allowed.
+void LoadTexture(const fs::path& mesh_dir, const std::string& mesh_path, const MeshLoadOptions& options,
+                 MeshMaterial* material, std::vector<std::string>* warnings) {
   const std::string name = material->texture_path;
-  if (name.empty()) return;
-  if (const aiTexture* embedded = scene.GetEmbeddedTexture(name.c_str())) {
-    material->texture = DecodeEmbedded(*embedded);
-    if (material->texture.empty()) ThrowInputError(mesh_path, "embedded texture " + name, "a decodable image");
-    return;
-  }
+  if (name.empty() || !material->texture.empty()) return;  // none, or embedded (decoded already)
   std::string relative = name;
   std::replace(relative.begin(), relative.end(), '\\', '/');
   const fs::path file = mesh_dir / relative;
@@ -121,6 +125,153 @@ MeshPart ConvertPart(const aiMesh& source) {
   return part;
 }
 
+// The mesh as assimp reads it, before units and transforms: geometry, materials, embedded textures decoded; texture
+// files only named (MeshMaterial::texture_path as the file gives it).
+TriangleMesh ImportMesh(const std::string& path) {
+  Assimp::Importer importer;
+  const unsigned flags = aiProcess_ValidateDataStructure | aiProcess_FindInvalidData | aiProcess_Triangulate |
+                         aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices | aiProcess_SortByPType |
+                         aiProcess_GenSmoothNormals;
+  const aiScene* scene = importer.ReadFile(path, flags);
+  if (scene == nullptr || scene->mRootNode == nullptr) {
+    ThrowInputError(path, "mesh", "a mesh file assimp can read", importer.GetErrorString());
+  }
+  TriangleMesh mesh;
+  mesh.name = fs::path(path).stem().string();
+  for (unsigned i = 0; i < scene->mNumMaterials; ++i) {
+    MeshMaterial& material = mesh.materials.emplace_back(ConvertMaterial(*scene->mMaterials[i]));
+    if (material.texture_path.empty()) continue;
+    if (const aiTexture* embedded = scene->GetEmbeddedTexture(material.texture_path.c_str())) {
+      material.texture = DecodeEmbedded(*embedded);
+      if (material.texture.empty()) {
+        ThrowInputError(path, "embedded texture " + material.texture_path, "a decodable image");
+      }
+    }
+  }
+  for (unsigned i = 0; i < scene->mNumMeshes; ++i) {
+    MeshPart part = ConvertPart(*scene->mMeshes[i]);
+    if (!part.triangles.empty()) mesh.parts.push_back(std::move(part));
+  }
+  return mesh;
+}
+
+// Writes all of `bytes` to `fd` (false when the pipe closes).
+bool WriteAll(int fd, const void* bytes, size_t size) {
+  const auto* data = static_cast<const char*>(bytes);
+  while (size > 0) {
+    const ssize_t written = write(fd, data, size);
+    if (written < 0 && errno == EINTR) continue;
+    if (written <= 0) return false;
+    data += written;
+    size -= static_cast<size_t>(written);
+  }
+  return true;
+}
+
+// The child's side: the mesh as a blob after 'M', or the error's message after 'E'; then _exit, so that nothing of
+// the parent's (buffers, atexit handlers) runs twice.
+[[noreturn]] void ImportInChild(const std::string& path, int fd) {
+  char status = 'M';
+  std::string payload;
+  try {
+    MeshBlobOptions raw;
+    raw.max_texture_size = 0;  // embedded textures as they are
+    raw.lz4_level = 1;
+    const std::vector<unsigned char> blob = EncodeMeshBlob(ImportMesh(path), raw);
+    payload.assign(blob.begin(), blob.end());
+  } catch (const InputError& error) {
+    status = 'E';
+    payload = error.what();
+  } catch (const std::exception& error) {  // the importer's own, e.g. a failed assertion: named with the file
+    status = 'E';
+    payload = path + ": mesh: expected a file the mesh importer reads, got " + error.what();
+  }
+  const uint64_t size = payload.size();
+  const bool sent =
+      WriteAll(fd, &status, 1) && WriteAll(fd, &size, sizeof(size)) && WriteAll(fd, payload.data(), payload.size());
+  _exit(sent ? 0 : 3);
+}
+
+// ImportMesh in a child process: assimp trusts what files say, and a malformed one can crash it; a crash there
+// becomes an InputError naming the file.
+TriangleMesh ImportMeshIsolated(const std::string& path) {
+  int fds[2];
+  if (pipe(fds) != 0) ThrowInputError(path, "mesh", "a pipe to read it through", std::strerror(errno));
+  const pid_t child = fork();
+  if (child < 0) {
+    close(fds[0]);
+    close(fds[1]);
+    ThrowInputError(path, "mesh", "a process to read it in", std::strerror(errno));
+  }
+  if (child == 0) {
+    close(fds[0]);
+    ImportInChild(path, fds[1]);
+  }
+  close(fds[1]);
+  std::string received;
+  char buffer[1 << 16];
+  for (;;) {
+    const ssize_t got = read(fds[0], buffer, sizeof(buffer));
+    if (got < 0 && errno == EINTR) continue;
+    if (got <= 0) break;
+    received.append(buffer, static_cast<size_t>(got));
+  }
+  close(fds[0]);
+  int wait_status = 0;
+  while (waitpid(child, &wait_status, 0) < 0 && errno == EINTR) {
+  }
+  if (WIFSIGNALED(wait_status)) {
+    ThrowInputError(path, "mesh", "a file the mesh importer reads without crashing",
+                    std::string("the importer crashed on it (") + strsignal(WTERMSIG(wait_status)) + ")");
+  }
+  uint64_t size = 0;
+  if (!WIFEXITED(wait_status) || WEXITSTATUS(wait_status) != 0 || received.size() < 1 + sizeof(size)) {
+    ThrowInputError(path, "mesh", "a file the mesh importer reads", "the importer stopped without a result");
+  }
+  std::memcpy(&size, received.data() + 1, sizeof(size));
+  if (received.size() != 1 + sizeof(size) + size) {
+    ThrowInputError(path, "mesh", "a file the mesh importer reads", "the importer's result was cut short");
+  }
+  const char* payload = received.data() + 1 + sizeof(size);
+  if (received[0] == 'E') throw InputError(std::string(payload, size));
+  return DecodeMeshBlob(reinterpret_cast<const unsigned char*>(payload), size, path);
+}
+
+// The OBJ's material libraries (mtllib lines) must exist: assimp would build the mesh grey without a word.
+void CheckObjMaterials(const std::string& path, const MeshLoadOptions& options, std::vector<std::string>* warnings) {
+  std::ifstream stream(path);
+  std::string line;
+  while (std::getline(stream, line)) {
+    std::istringstream words(line);
+    std::string keyword, library;
+    words >> keyword;
+    if (keyword != "mtllib") continue;
+    std::getline(words >> std::ws, library);
+    library = Trim(library);
+    const fs::path file = fs::path(path).parent_path() / library;
+    if (library.empty() || fs::exists(file)) continue;
+    const std::string message = path + ": material library '" + library + "' not found at " + file.string();
+    if (!options.allow_missing_textures) {
+      throw InputError(message + " (give --allow-missing-textures to build it with default colours)");
+    }
+    if (warnings != nullptr) warnings->push_back(message + "; using default colours");
+  }
+}
+
+// Every vertex position finite: NaN or infinite coordinates would make every measure of the mesh meaningless.
+void CheckFinite(const std::string& path, const TriangleMesh& mesh) {
+  for (size_t p = 0; p < mesh.parts.size(); ++p) {
+    const std::vector<Eigen::Vector3f>& positions = mesh.parts[p].positions;
+    for (size_t i = 0; i < positions.size(); ++i) {
+      if (!positions[i].allFinite()) {
+        ThrowInputError(path,
+                        "vertex " + std::to_string(i) + (mesh.parts.size() > 1 ? " of part " + std::to_string(p) : ""),
+                        "finite coordinates", "NaN or infinite");
+      }
+    }
+  }
+}
+
 }  // namespace
 
 void MeshLoadOptions::Check() const {
@@ -167,28 +318,15 @@ TriangleMesh LoadMesh(const std::string& path, const MeshLoadOptions& options, s
   options.Check();
   if (!fs::exists(path)) ThrowInputError(path, "mesh", "an existing file", "no such file");
   if (fs::is_directory(path)) ThrowInputError(path, "mesh", "a mesh file", "a directory");
+  const std::string extension = Lowercase(fs::path(path).extension().string());
+  if (extension == ".ply") CheckPlyFile(path);
+  if (extension == ".obj") CheckObjMaterials(path, options, warnings);
 
-  Assimp::Importer importer;
-  const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices |
-                         aiProcess_SortByPType | aiProcess_GenSmoothNormals;
-  const aiScene* scene = importer.ReadFile(path, flags);
-  if (scene == nullptr || scene->mRootNode == nullptr) {
-    ThrowInputError(path, "mesh", "a mesh file assimp can read", importer.GetErrorString());
-  }
-
-  TriangleMesh mesh;
-  mesh.name = fs::path(path).stem().string();
+  TriangleMesh mesh = ImportMeshIsolated(path);
   const fs::path mesh_dir = fs::path(path).parent_path();
-  for (unsigned i = 0; i < scene->mNumMaterials; ++i) {
-    mesh.materials.push_back(ConvertMaterial(*scene->mMaterials[i]));
-    LoadTexture(*scene, mesh_dir, path, options, &mesh.materials.back(), warnings);
-  }
-  for (unsigned i = 0; i < scene->mNumMeshes; ++i) {
-    MeshPart part = ConvertPart(*scene->mMeshes[i]);
-    if (!part.triangles.empty()) mesh.parts.push_back(std::move(part));
-  }
+  for (MeshMaterial& material : mesh.materials) LoadTexture(mesh_dir, path, options, &material, warnings);
   if (mesh.NumTriangles() == 0) ThrowInputError(path, "faces", "a mesh with triangles", "no triangles");
-
+  CheckFinite(path, mesh);
   mesh.Scale(options.metres_per_unit);
   mesh.Transform(options.object_from_mesh);
   return mesh;

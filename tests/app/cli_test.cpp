@@ -22,7 +22,10 @@ TEST(Cli, VersionHelpAndUsageErrors) {
   EXPECT_EQ(help.exit_code, 0);
   EXPECT_THAT(help.output, HasSubstr("info"));
   EXPECT_EQ(test::RunCli("").exit_code, 2);
-  EXPECT_EQ(test::RunCli("no-such-command").exit_code, 2);
+  const test::CommandResult unknown = test::RunCli("no-such-command");
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_THAT(unknown.output,
+              AllOf(HasSubstr("unknown subcommand 'no-such-command'"), HasSubstr("info"), HasSubstr("recognize")));
   EXPECT_EQ(test::RunCli("info --no-such-flag").exit_code, 2);
   EXPECT_EQ(test::RunCli("info --unit inch x.obj").exit_code, 2);
   EXPECT_EQ(test::RunCli("info --help").exit_code, 0);

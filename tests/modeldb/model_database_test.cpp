@@ -394,3 +394,30 @@ TEST(ModelDatabase, AFailedMigrationLeavesTheOldFileAsItWas) {
 
 }  // namespace
 }  // namespace ecv
+
+namespace ecv {
+namespace {
+
+// A writer queued behind another process's lock says, once, what it waits for; a writer that cannot take the lock
+// fails when it opens the library, not after the work it would store.
+TEST(SqlConnection, AWriterWaitingForTheLockSaysSoAndFailsAtOpen) {
+  const test::TemporaryDirectory directory;
+  const std::string path = directory.File("locked.sqlite");
+  SqlConnection holder(path, SqlOpenMode::kCreate, 1000);
+  holder.Execute("PRAGMA journal_mode = WAL; CREATE TABLE t (x INTEGER); BEGIN IMMEDIATE; INSERT INTO t VALUES (1)");
+  ::testing::internal::CaptureStderr();
+  try {
+    SqlConnection waiting(path, SqlOpenMode::kReadWrite, 1500);
+    ADD_FAILURE() << "opened for writing while another connection holds the write lock";
+  } catch (const SqlError& error) {
+    EXPECT_THAT(error.what(), ::testing::AllOf(::testing::HasSubstr(path), ::testing::HasSubstr("cannot write")));
+  }
+  const std::string said = ::testing::internal::GetCapturedStderr();
+  EXPECT_THAT(said, ::testing::HasSubstr("waiting for the library's lock"));
+  holder.Execute("ROLLBACK");
+  EXPECT_NO_THROW(SqlConnection(path, SqlOpenMode::kReadWrite, 1500));
+  EXPECT_NO_THROW(SqlConnection(path, SqlOpenMode::kReadOnly, 1500));
+}
+
+}  // namespace
+}  // namespace ecv

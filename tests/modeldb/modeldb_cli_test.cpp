@@ -4,8 +4,10 @@
 
 #include <unistd.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -53,8 +55,38 @@ void LinkModels(const fs::path& directory, const std::vector<std::string>& names
 }
 
 // Runs ecvpose with `arguments`, as an unprivileged user when we are root (so that file permissions hold).
+// A copy of the ecvpose binary and its own libraries in a folder every user can read: the unprivileged user may not
+// reach the build tree (a checkout under /root, or in a private folder). The shell command that runs the copy.
+std::string CliCopyForEveryone() {
+  static test::TemporaryDirectory folder;
+  static const std::string command = [] {
+    const fs::path bin = folder.path();
+    const auto everyone = fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec |
+                          fs::perms::others_read | fs::perms::others_exec;
+    fs::permissions(bin, everyone);
+    fs::copy_file(ECV_CLI_PATH, bin / "ecvpose", fs::copy_options::overwrite_existing);
+    FILE* ldd = popen(("ldd " + std::string(ECV_CLI_PATH)).c_str(), "r");
+    char line[4096];
+    while (ldd != nullptr && std::fgets(line, sizeof(line), ldd) != nullptr) {
+      std::istringstream words(line);
+      std::string name, arrow, path;
+      words >> name >> arrow >> path;  // "libecv_core.so.0 => /path/libecv_core.so.0 (0x...)"
+      if (name.rfind("libecv_", 0) == 0 && arrow == "=>") {
+        fs::copy_file(path, bin / name, fs::copy_options::overwrite_existing);
+      }
+    }
+    if (ldd != nullptr) pclose(ldd);
+    for (const auto& entry : fs::directory_iterator(bin)) fs::permissions(entry.path(), everyone);
+    return "env LD_LIBRARY_PATH=" + bin.string() + " " + (bin / "ecvpose").string();
+  }();
+  return command;
+}
+
+// Runs the CLI as user nobody (when we are root) from a copy every user can read.
 test::CommandResult RunCliUnprivileged(const std::string& arguments) {
-  return test::RunCli(arguments, geteuid() == 0 ? "setpriv --reuid=65534 --regid=65534 --clear-groups " : "");
+  if (geteuid() != 0) return test::RunCli(arguments);
+  return test::RunCommand("setpriv --reuid=65534 --regid=65534 --clear-groups " + CliCopyForEveryone() + " " +
+                          arguments);
 }
 
 // One library built by the CLI, shared by the tests (each works on its own copy when it changes it).
@@ -188,6 +220,47 @@ TEST_F(ModeldbCli, ReportsABadMeshInADirectoryAndBuildsTheRest) {
   EXPECT_EQ(models[0].name, "006_mustard_bottle");
 }
 
+// The malformed PLYs that crashed the mesh importer: each reported, naming the file, and the rest of the directory
+// built.
+TEST_F(ModeldbCli, MalformedPlysAreReportedAndTheRestBuilt) {
+  const fs::path meshes = scratch_.path() / "meshes";
+  LinkModels(meshes, {kModels[1]});
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 2\nproperty list uchar int vertex_indices\nend_header\n";
+  fs::create_directories(meshes / "index");
+  std::ofstream(meshes / "index" / "index.ply")
+      << header << "0 0 0\n0.1 0 0\n0 0.1 0\n0 0 0.1\n3 0 1 2\n3 0 1 4000000\n";
+  fs::create_directories(meshes / "short");
+  std::ofstream(meshes / "short" / "short.ply") << header << "0 0 0\n0.1 0 0\n";
+  const std::string library = scratch_.File("lib.sqlite");
+  const test::CommandResult result =
+      test::RunCli("modeldb build " + meshes.string() + " --db " + library + QuickFlags(1));
+  EXPECT_EQ(result.exit_code, 1) << result.output;
+  EXPECT_THAT(result.output, AllOf(HasSubstr("index.ply: face 1"), HasSubstr("short.ply: vertex 2"),
+                                   HasSubstr("built 1 of 3 models")));
+  EXPECT_EQ(ModelDatabase(library, OpenMode::kReadOnly).ListModels().size(), 1U);
+}
+
+// A mesh in the wrong unit (a box 2 m across written in millimetres and read as metres: 2 km) is refused before any
+// view is rendered, naming --unit; so is one too small to see.
+TEST_F(ModeldbCli, AMeshOfAnImplausibleSizeNamesTheUnit) {
+  auto box = [&](const std::string& name, const std::string& side) {
+    const std::string path = scratch_.File(name);
+    std::ofstream(path) << "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+                           "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n"
+                        << "0 0 0\n"
+                        << side << " 0 0\n0 " << side << " 0\n0 0 " << side << "\n3 0 1 2\n3 0 2 3\n";
+    return path;
+  };
+  const std::string library = scratch_.File("unit.sqlite");
+  for (const std::string& mesh : {box("huge.ply", "2000"), box("tiny.ply", "0.0002")}) {
+    const test::CommandResult result = test::RunCli("modeldb build " + mesh + " --db " + library + QuickFlags(1));
+    EXPECT_EQ(result.exit_code, 1) << result.output;
+    EXPECT_THAT(result.output, AllOf(HasSubstr(mesh), HasSubstr("--unit"), Not(HasSubstr("view 1/"))));
+  }
+}
+
 TEST_F(ModeldbCli, ReadsButDoesNotWriteInAReadOnlyLocation) {
   const fs::path read_only = scratch_.path() / "read_only";
   fs::create_directories(read_only);
@@ -202,7 +275,10 @@ TEST_F(ModeldbCli, ReadsButDoesNotWriteInAReadOnlyLocation) {
   const test::CommandResult verify = RunCliUnprivileged("modeldb verify --db " + library);
   EXPECT_EQ(verify.exit_code, 0) << verify.output;
 
-  const std::string mustard = test::DemoMeshDirectory() + "/006_mustard_bottle";
+  // The mesh copied where every user can read it: the checkout may be in a private folder.
+  const fs::path mustard_copy = scratch_.path() / "006_mustard_bottle";
+  fs::copy(test::DemoMeshDirectory() + "/006_mustard_bottle", mustard_copy, fs::copy_options::recursive);
+  const std::string mustard = mustard_copy.string();
   const test::CommandResult create =
       RunCliUnprivileged("modeldb build " + mustard + " --db " + (read_only / "new.sqlite").string() + QuickFlags(1));
   EXPECT_EQ(create.exit_code, 1) << create.output;
@@ -225,7 +301,15 @@ TEST_F(ModeldbCli, RefusesFilesThatAreNotLibrariesOfThisVersion) {
   SqlConnection(newer, SqlOpenMode::kReadWrite, 1000).Execute("PRAGMA user_version = 9");
   const test::CommandResult refused = test::RunCli("modeldb list --db " + newer);
   EXPECT_EQ(refused.exit_code, 1);
-  EXPECT_THAT(refused.output, AllOf(HasSubstr("schema version 9"), HasSubstr("ecvpose 0.2.0 or newer")));
+  // The file asks for no later ecvpose than this one: a newer release, not this version, is what reads it.
+  EXPECT_THAT(refused.output, AllOf(HasSubstr("schema version 9"), HasSubstr("reads versions up to"),
+                                    HasSubstr("use ecvpose of a newer release")));
+  SqlConnection(newer, SqlOpenMode::kReadWrite, 1000)
+      .Execute("UPDATE meta SET value = '9.1.0' WHERE key = 'min_ecvpose_version'");
+  EXPECT_THAT(test::RunCli("modeldb list --db " + newer).output, HasSubstr("use ecvpose 9.1.0 or newer"));
+  const test::CommandResult folder = test::RunCli("modeldb list --db " + scratch_.path().string());
+  EXPECT_EQ(folder.exit_code, 1);
+  EXPECT_THAT(folder.output, HasSubstr("is a directory"));
 
   const std::string old = scratch_.File("old.sqlite");
   test::WritePrototypeLibrary(old, {test::SyntheticModel("a", 2, 20, 1)});
@@ -236,6 +320,17 @@ TEST_F(ModeldbCli, RefusesFilesThatAreNotLibrariesOfThisVersion) {
   EXPECT_EQ(migrated.exit_code, 0) << migrated.output;
   EXPECT_THAT(migrated.output, HasSubstr("from schema version 0 to 2"));
   EXPECT_EQ(test::RunCli("modeldb list --db " + old).exit_code, 0);
+}
+
+TEST_F(ModeldbCli, RecognizeRefusesALibraryWithoutModels) {
+  const std::string library = CopyOfLibrary();
+  for (const char* name : {"003_cracker_box", "006_mustard_bottle"}) {
+    EXPECT_EQ(test::RunCli("modeldb remove " + std::string(name) + " --db " + library).exit_code, 0);
+  }
+  const test::CommandResult empty =
+      test::RunCli("recognize --db " + library + " " + std::string(ECV_SOURCE_DIR) + "/models/frame/000001");
+  EXPECT_EQ(empty.exit_code, 1) << empty.output;
+  EXPECT_THAT(empty.output, AllOf(HasSubstr(library), HasSubstr("at least one model")));
 }
 
 TEST_F(ModeldbCli, BadUsageExitsWithTwo) {

@@ -32,7 +32,11 @@ TemporaryDirectory::~TemporaryDirectory() {
 }
 
 CommandResult RunCli(const std::string& arguments, const std::string& prefix) {
-  const std::string command = prefix + ECV_CLI_PATH + " " + arguments + " 2>&1";
+  return RunCommand(prefix + ECV_CLI_PATH + " " + arguments);
+}
+
+CommandResult RunCommand(const std::string& shell_command) {
+  const std::string command = shell_command + " 2>&1";
   CommandResult result;
   FILE* pipe = popen(command.c_str(), "r");
   if (pipe == nullptr) return result;

@@ -34,4 +34,7 @@ struct CommandResult {
 /// privileges) when given.
 CommandResult RunCli(const std::string& arguments, const std::string& prefix = "");
 
+/// Runs `command` (shell syntax) with standard error joined to standard output.
+CommandResult RunCommand(const std::string& command);
+
 }  // namespace ecv::test
