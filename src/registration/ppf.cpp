@@ -1,0 +1,363 @@
+// Point pair features: the model's table of quantized pair features, and voting for poses in a scene (Drost et al.
+// 2010, Sect. 3; the refinements of Vidal et al. 2018, Sect. 3).
+
+#include "registration/ppf.h"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <string>
+
+#include "core/error.h"
+
+namespace ecv {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Integer voxel coordinates packed into one key (21 bits each, offset so that negative coordinates fit).
+uint64_t VoxelKey(const Eigen::Vector3f& point, double voxel) {
+  auto cell = [&](float v) { return static_cast<uint64_t>(static_cast<int64_t>(std::floor(v / voxel)) + (1 << 20)); };
+  return (cell(point.x()) & 0x1FFFFF) << 42 | (cell(point.y()) & 0x1FFFFF) << 21 | (cell(point.z()) & 0x1FFFFF);
+}
+
+float Angle(const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
+  return std::atan2(a.cross(b).norm(), a.dot(b));
+}
+
+// The rotation that turns `normal` onto +x (Drost's T_{m->g} without its translation).
+Eigen::Matrix3f ToXAxis(const Eigen::Vector3f& normal) {
+  const Eigen::Vector3f x = Eigen::Vector3f::UnitX();
+  const Eigen::Vector3f axis = normal.cross(x);
+  const float sine = axis.norm(), cosine = normal.dot(x);
+  if (sine < 1e-6F)
+    return cosine > 0.0F ? Eigen::Matrix3f::Identity()
+                         : Eigen::Matrix3f(Eigen::AngleAxisf(kPi, Eigen::Vector3f::UnitZ()));
+  return Eigen::AngleAxisf(std::atan2(sine, cosine), axis / sine).toRotationMatrix();
+}
+
+// The angle about x that turns `local` (a point in a reference point's frame) into the half-plane y >= 0, z = 0.
+float AlphaOf(const Eigen::Vector3f& local) {
+  return std::atan2(-local.z(), local.y());
+}
+
+// Quantized features of a pair: the distance and the three angles, as bin positions (fractional) and the key.
+class FeatureBins {
+ public:
+  FeatureBins(double diameter_m, const PpfOptions& options)
+      : distance_bins_(static_cast<int>(std::ceil(1.0 / options.distance_step)) + 1),
+        angle_bins_(options.angle_bins),
+        per_distance_(static_cast<float>(1.0 / (options.distance_step * diameter_m))),
+        per_angle_(static_cast<float>(options.angle_bins / kPi)),
+        coplanar_(static_cast<float>(options.coplanar_deg * kPi / 180.0)) {}
+
+  // The pair's bin positions (distance, angle(n1, d), angle(n2, d), angle(n1, n2)); false when beyond the diameter
+  // or coplanar (PpfOptions::coplanar_deg).
+  bool Positions(const OrientedPoint& a, const OrientedPoint& b, float positions[4]) const {
+    const Eigen::Vector3f d = b.position - a.position;
+    const float length = d.norm();
+    positions[0] = length * per_distance_;
+    if (!(positions[0] < static_cast<float>(distance_bins_)) || length <= 0.0F) return false;
+    const float a1 = Angle(a.normal, d), a2 = Angle(b.normal, d), a3 = Angle(a.normal, b.normal);
+    if (a3 < coplanar_ && std::abs(a1 - kHalfPi) < coplanar_ && std::abs(a2 - kHalfPi) < coplanar_) return false;
+    positions[1] = a1 * per_angle_;
+    positions[2] = a2 * per_angle_;
+    positions[3] = a3 * per_angle_;
+    return true;
+  }
+
+  uint32_t Key(const int bins[4]) const {
+    return ((static_cast<uint32_t>(bins[0]) * angle_bins_ + bins[1]) * angle_bins_ + bins[2]) * angle_bins_ + bins[3];
+  }
+
+  // The pair's own key, and with `spread` also those with each value moved to its nearer neighbouring bin (up to 16).
+  int Keys(const float positions[4], bool spread, uint32_t keys[16]) const {
+    int bins[4], other[4];
+    for (int k = 0; k < 4; ++k) {
+      const int limit = k == 0 ? distance_bins_ : angle_bins_;
+      bins[k] = std::min(static_cast<int>(positions[k]), limit - 1);
+      const float remainder = positions[k] - static_cast<float>(bins[k]);
+      other[k] = remainder < 0.5F ? bins[k] - 1 : bins[k] + 1;
+      if (other[k] < 0 || other[k] >= limit) other[k] = bins[k];
+    }
+    if (!spread) {
+      keys[0] = Key(bins);
+      return 1;
+    }
+    int count = 0;
+    for (int mask = 0; mask < 16; ++mask) {
+      int chosen[4];
+      bool repeated = false;
+      for (int k = 0; k < 4; ++k) {
+        const bool moved = (mask >> k) & 1;
+        if (moved && other[k] == bins[k]) repeated = true;
+        chosen[k] = moved ? other[k] : bins[k];
+      }
+      if (!repeated) keys[count++] = Key(chosen);
+    }
+    return count;
+  }
+
+ private:
+  static constexpr float kHalfPi = static_cast<float>(kPi / 2.0);
+  int distance_bins_, angle_bins_;
+  float per_distance_, per_angle_, coplanar_;
+};
+
+// Scene points by cells of one diameter, for the pairs of a reference point.
+class CellGrid {
+ public:
+  CellGrid(const std::vector<OrientedPoint>& points, double cell) : cell_(cell) {
+    for (size_t i = 0; i < points.size(); ++i)
+      cells_[VoxelKey(points[i].position, cell)].push_back(static_cast<int>(i));
+  }
+
+  template <typename Visit>
+  void ForNear(const Eigen::Vector3f& centre, Visit visit) const {
+    for (int dx = -1; dx <= 1; ++dx) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dz = -1; dz <= 1; ++dz) {
+          const Eigen::Vector3f moved = centre + static_cast<float>(cell_) * Eigen::Vector3f(dx, dy, dz);
+          const auto found = cells_.find(VoxelKey(moved, cell_));
+          if (found == cells_.end()) continue;
+          for (const int i : found->second) visit(i);
+        }
+      }
+    }
+  }
+
+ private:
+  double cell_;
+  std::unordered_map<uint64_t, std::vector<int>> cells_;
+};
+
+// Pose votes of one reference point, clustered with the others' afterwards.
+struct Vote {
+  Eigen::Isometry3d pose;
+  double votes;
+};
+
+// Greedy clustering (Drost Sect. 3.4): poses by votes, each joining the first cluster whose leading pose is close.
+std::vector<PpfPose> ClusterPoses(std::vector<Vote> votes, double diameter_m, const PpfOptions& options) {
+  std::stable_sort(votes.begin(), votes.end(), [](const Vote& a, const Vote& b) { return a.votes > b.votes; });
+  const double max_distance = options.cluster_distance * diameter_m;
+  const double max_angle = options.cluster_angle_deg * kPi / 180.0;
+  std::vector<PpfPose> clusters;
+  for (const Vote& vote : votes) {
+    bool joined = false;
+    for (PpfPose& cluster : clusters) {
+      const Eigen::Isometry3d& lead = cluster.camera_from_object;
+      if ((lead.translation() - vote.pose.translation()).norm() > max_distance) continue;
+      if (Eigen::AngleAxisd(lead.linear().transpose() * vote.pose.linear()).angle() > max_angle) continue;
+      cluster.votes += vote.votes;
+      joined = true;
+      break;
+    }
+    if (!joined && clusters.size() < 2000) clusters.push_back({vote.pose, vote.votes});
+  }
+  std::stable_sort(clusters.begin(), clusters.end(),
+                   [](const PpfPose& a, const PpfPose& b) { return a.votes > b.votes; });
+  if (clusters.size() > static_cast<size_t>(options.max_poses)) clusters.resize(static_cast<size_t>(options.max_poses));
+  return clusters;
+}
+
+}  // namespace
+
+void PpfOptions::Check() const {
+  auto require = [](bool ok, const char* field, const char* expected) {
+    if (!ok) ThrowInputError("point pair options", field, expected);
+  };
+  require(sampling > 0.0 && sampling < 1.0, "sampling", "a share of the diameter in (0, 1)");
+  require(distance_step > 0.0 && distance_step < 1.0, "distance_step", "a share of the diameter in (0, 1)");
+  require(angle_bins >= 4 && angle_bins <= 180, "angle_bins", "4 to 180");
+  require(keep_normal_deg > 0.0 && keep_normal_deg <= 180.0, "keep_normal_deg", "in (0, 180] degrees");
+  require(scene_reference_step >= 1, "scene_reference_step", "at least 1");
+  require(poses_per_reference >= 1, "poses_per_reference", "at least 1");
+  require(cluster_distance > 0.0, "cluster_distance", "> 0");
+  require(cluster_angle_deg > 0.0, "cluster_angle_deg", "> 0 degrees");
+  require(max_poses >= 1, "max_poses", "at least 1");
+  require(coplanar_deg >= 0.0 && coplanar_deg < 90.0, "coplanar_deg", "in [0, 90) degrees");
+}
+
+std::vector<OrientedPoint> SubsampleByNormals(const std::vector<OrientedPoint>& points, double voxel_m,
+                                              double keep_normal_deg) {
+  const float min_cosine = static_cast<float>(std::cos(keep_normal_deg * kPi / 180.0));
+  std::unordered_map<uint64_t, std::vector<int>> voxels;
+  std::vector<uint64_t> order;  // voxels in the order first met, so that the result does not depend on hashing
+  for (size_t i = 0; i < points.size(); ++i) {
+    auto [entry, added] = voxels.try_emplace(VoxelKey(points[i].position, voxel_m));
+    if (added) order.push_back(entry->first);
+    entry->second.push_back(static_cast<int>(i));
+  }
+  std::vector<OrientedPoint> kept;
+  for (const uint64_t key : order) {
+    std::vector<int>& members = voxels[key];
+    const Eigen::Vector3f centre =
+        (points[static_cast<size_t>(members[0])].position / static_cast<float>(voxel_m)).array().floor().matrix() *
+            static_cast<float>(voxel_m) +
+        Eigen::Vector3f::Constant(static_cast<float>(voxel_m / 2.0));
+    std::stable_sort(members.begin(), members.end(), [&](int a, int b) {
+      return (points[static_cast<size_t>(a)].position - centre).squaredNorm() <
+             (points[static_cast<size_t>(b)].position - centre).squaredNorm();
+    });
+    const size_t first = kept.size();
+    for (const int m : members) {
+      const OrientedPoint& point = points[static_cast<size_t>(m)];
+      const bool similar = std::any_of(kept.begin() + static_cast<std::ptrdiff_t>(first), kept.end(),
+                                       [&](const OrientedPoint& k) { return k.normal.dot(point.normal) > min_cosine; });
+      if (!similar) kept.push_back(point);
+    }
+  }
+  return kept;
+}
+
+std::vector<OrientedPoint> SampleMeshSurface(const TriangleMesh& mesh, int count, uint64_t seed) {
+  struct Face {
+    const MeshPart* part;
+    Eigen::Vector3i triangle;
+  };
+  std::vector<Face> faces;
+  std::vector<double> cumulative;
+  double total = 0.0;
+  for (const MeshPart& part : mesh.parts) {
+    for (const Eigen::Vector3i& t : part.triangles) {
+      const Eigen::Vector3f& a = part.positions[static_cast<size_t>(t[0])];
+      const double area =
+          0.5 *
+          (part.positions[static_cast<size_t>(t[1])] - a).cross(part.positions[static_cast<size_t>(t[2])] - a).norm();
+      if (!(area > 0.0)) continue;
+      total += area;
+      faces.push_back({&part, t});
+      cumulative.push_back(total);
+    }
+  }
+  std::vector<OrientedPoint> samples;
+  if (faces.empty() || count <= 0) return samples;
+  std::mt19937_64 random(seed);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  samples.reserve(static_cast<size_t>(count));
+  for (int s = 0; s < count; ++s) {
+    const size_t f = static_cast<size_t>(
+        std::lower_bound(cumulative.begin(), cumulative.end(), uniform(random) * total) - cumulative.begin());
+    const Face& face = faces[std::min(f, faces.size() - 1)];
+    const MeshPart& part = *face.part;
+    double u = uniform(random), v = uniform(random);
+    if (u + v > 1.0) u = 1.0 - u, v = 1.0 - v;
+    const Eigen::Vector3f a = part.positions[static_cast<size_t>(face.triangle[0])];
+    const Eigen::Vector3f b = part.positions[static_cast<size_t>(face.triangle[1])];
+    const Eigen::Vector3f c = part.positions[static_cast<size_t>(face.triangle[2])];
+    OrientedPoint point;
+    point.position = a + static_cast<float>(u) * (b - a) + static_cast<float>(v) * (c - a);
+    point.normal = (b - a).cross(c - a).normalized();
+    if (!part.normals.empty()) {
+      const Eigen::Vector3f vertex_normal = part.normals[static_cast<size_t>(face.triangle[0])] +
+                                            part.normals[static_cast<size_t>(face.triangle[1])] +
+                                            part.normals[static_cast<size_t>(face.triangle[2])];
+      if (vertex_normal.dot(point.normal) < 0.0F) point.normal = -point.normal;
+    }
+    samples.push_back(point);
+  }
+  return samples;
+}
+
+PpfModel::PpfModel(const std::vector<OrientedPoint>& surface, double diameter_m, const PpfOptions& options)
+    : diameter_m_(diameter_m), options_(options) {
+  options.Check();
+  if (!(diameter_m > 0.0)) ThrowInputError("point pair model", "diameter_m", "> 0 m", std::to_string(diameter_m));
+  points_ = SubsampleByNormals(surface, options.sampling * diameter_m, options.keep_normal_deg);
+  if (points_.size() < 10) {
+    ThrowInputError("point pair model", "surface", "at least 10 points after sub-sampling",
+                    std::to_string(points_.size()));
+  }
+  const FeatureBins bins(diameter_m, options);
+  for (size_t r = 0; r < points_.size(); ++r) {
+    const Eigen::Matrix3f to_x = ToXAxis(points_[r].normal);
+    for (size_t i = 0; i < points_.size(); ++i) {
+      if (i == r) continue;
+      float positions[4];
+      if (!bins.Positions(points_[r], points_[i], positions)) continue;
+      uint32_t key[16];
+      bins.Keys(positions, false, key);
+      const float alpha = AlphaOf(to_x * (points_[i].position - points_[r].position));
+      table_[key[0]].push_back({static_cast<uint32_t>(r), alpha});
+      ++pairs_;
+    }
+  }
+  if (pairs_ < 100) {
+    ThrowInputError("point pair model", "surface", "a surface with relief (at least 100 pairs not in one plane)",
+                    std::to_string(pairs_) + " pairs");
+  }
+}
+
+const std::vector<PpfModel::Entry>* PpfModel::Find(uint32_t key) const {
+  const auto found = table_.find(key);
+  return found == table_.end() ? nullptr : &found->second;
+}
+
+std::vector<PpfPose> FindPpfPoses(const PpfModel& model, const std::vector<OrientedPoint>& scene_points) {
+  const PpfOptions& options = model.options();
+  const double diameter = model.diameter_m();
+  const std::vector<OrientedPoint> scene =
+      SubsampleByNormals(scene_points, options.sampling * diameter, options.keep_normal_deg);
+  const FeatureBins bins(diameter, options);
+  const CellGrid grid(scene, diameter);
+  const size_t model_points = model.points().size();
+  const int angle_bins = options.angle_bins;
+  std::vector<int> accumulator(model_points * static_cast<size_t>(angle_bins));
+  std::vector<int> voted_by(accumulator.size(), -1);  // the scene pair that last voted for a cell: once per pair
+  std::vector<Eigen::Matrix3f> model_to_x(model_points);
+  for (size_t m = 0; m < model_points; ++m) model_to_x[m] = ToXAxis(model.points()[m].normal);
+  std::vector<Vote> votes;
+  const float squared_diameter = static_cast<float>(diameter * diameter);
+  int pair = 0;
+  for (size_t r = 0; r < scene.size(); r += static_cast<size_t>(options.scene_reference_step)) {
+    const OrientedPoint& reference = scene[r];
+    const Eigen::Matrix3f to_x = ToXAxis(reference.normal);
+    std::fill(accumulator.begin(), accumulator.end(), 0);
+    grid.ForNear(reference.position, [&](int i) {
+      if (static_cast<size_t>(i) == r) return;
+      const OrientedPoint& other = scene[static_cast<size_t>(i)];
+      if ((other.position - reference.position).squaredNorm() > squared_diameter) return;
+      float positions[4];
+      if (!bins.Positions(reference, other, positions)) return;
+      uint32_t keys[16];
+      const int count = bins.Keys(positions, options.spread_votes, keys);
+      const float alpha_scene = AlphaOf(to_x * (other.position - reference.position));
+      ++pair;
+      for (int k = 0; k < count; ++k) {
+        const std::vector<PpfModel::Entry>* entries = model.Find(keys[k]);
+        if (entries == nullptr) continue;
+        for (const PpfModel::Entry& entry : *entries) {
+          float alpha = entry.alpha - alpha_scene;
+          if (alpha < -kPi) alpha += 2.0F * static_cast<float>(kPi);
+          if (alpha >= kPi) alpha -= 2.0F * static_cast<float>(kPi);
+          const int bin = std::min(static_cast<int>((alpha + kPi) / (2.0 * kPi) * angle_bins), angle_bins - 1);
+          const size_t cell = entry.reference * static_cast<size_t>(angle_bins) + static_cast<size_t>(bin);
+          if (voted_by[cell] == pair) continue;
+          voted_by[cell] = pair;
+          ++accumulator[cell];
+        }
+      }
+    });
+    // The reference point's best cells as poses: camera_from_object = T_s^-1 R_x(alpha) T_m.
+    for (int best = 0; best < options.poses_per_reference; ++best) {
+      const auto peak = std::max_element(accumulator.begin(), accumulator.end());
+      if (*peak < 3) break;
+      const size_t cell = static_cast<size_t>(peak - accumulator.begin());
+      const size_t m = cell / static_cast<size_t>(angle_bins);
+      const double alpha =
+          (static_cast<double>(cell % static_cast<size_t>(angle_bins)) + 0.5) * 2.0 * kPi / angle_bins - kPi;
+      const Eigen::Matrix3d rotation = to_x.transpose().cast<double>() *
+                                       Eigen::AngleAxisd(alpha, Eigen::Vector3d::UnitX()).toRotationMatrix() *
+                                       model_to_x[m].cast<double>();
+      Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+      pose.linear() = rotation;
+      pose.translation() = reference.position.cast<double>() - rotation * model.points()[m].position.cast<double>();
+      votes.push_back({pose, static_cast<double>(*peak)});
+      *peak = 0;
+    }
+  }
+  return ClusterPoses(std::move(votes), diameter, options);
+}
+
+}  // namespace ecv

@@ -1,0 +1,88 @@
+#pragma once
+
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "core/mesh.h"
+
+namespace ecv {
+
+/// A surface point with its unit normal (facing out of the object, or towards the camera), metres.
+struct OrientedPoint {
+  Eigen::Vector3f position = Eigen::Vector3f::Zero();
+  Eigen::Vector3f normal = Eigen::Vector3f::UnitZ();
+};
+
+/// Point pair features (Drost, Ulrich, Navab, Ilic, CVPR 2010) with refinements of Vidal, Lin, Llado and Marti
+/// (Sensors 2018): sub-sampling that keeps points of differing normals, votes spread to the neighbouring feature
+/// bins, each scene pair voting once per pose bin, and pose clustering. Steps are shares of the model's diameter.
+struct PpfOptions {
+  double sampling = 0.05;           ///< voxel of the model and scene sub-sampling, share of the diameter
+  double distance_step = 0.05;      ///< feature distance bin, share of the diameter (Drost's tau_d)
+  int angle_bins = 30;              ///< bins of each feature angle and of the rotation about the normal (12 degrees)
+  double keep_normal_deg = 30.0;    ///< a voxel keeps a second point whose normal differs by more than this
+  int scene_reference_step = 5;     ///< every n-th sub-sampled scene point is a reference point
+  bool spread_votes = true;         ///< also look up the neighbouring bin of each feature value near a bin border
+  int poses_per_reference = 3;      ///< the best poses of each reference point kept for clustering
+  double cluster_distance = 0.1;    ///< poses closer than this (share of the diameter) ...
+  double cluster_angle_deg = 30.0;  ///< ... and turned less than this join one cluster
+  int max_poses = 20;               ///< clusters returned, most votes first
+  /// Pairs of one plane (normals within this and both at 90 +- this degrees to the line between them) neither go
+  /// into the table nor vote (0: all pairs): a table top or a box face alone gives thousands of them, all alike.
+  double coplanar_deg = 0.0;
+
+  /// Throws InputError on values outside their ranges.
+  void Check() const;
+};
+
+/// `points` sub-sampled on a voxel grid of `voxel_m`: per voxel the point nearest its centre, and another for each
+/// normal more than `keep_normal_deg` from those kept (Vidal et al.: thin parts and edges keep both sides).
+std::vector<OrientedPoint> SubsampleByNormals(const std::vector<OrientedPoint>& points, double voxel_m,
+                                              double keep_normal_deg);
+
+/// Points spread over a mesh's triangles, `count` of them in proportion to area (seeded), with the triangle's
+/// normal (turned by the vertex normals' side when the mesh has them).
+std::vector<OrientedPoint> SampleMeshSurface(const TriangleMesh& mesh, int count, uint64_t seed = 1);
+
+/// A model's point pair table: every ordered pair of its sub-sampled points by quantized feature.
+class PpfModel {
+ public:
+  /// From the model's surface points (object frame) and its diameter (metres); throws InputError when fewer than
+  /// 10 points remain after sub-sampling or fewer than 100 pairs go into the table (a mesh too small, flat or
+  /// coarse for point pairs).
+  PpfModel(const std::vector<OrientedPoint>& surface, double diameter_m, const PpfOptions& options = {});
+
+  const std::vector<OrientedPoint>& points() const { return points_; }
+  double diameter_m() const { return diameter_m_; }
+  const PpfOptions& options() const { return options_; }
+  size_t NumPairs() const { return pairs_; }
+
+  /// The model reference point of every pair with feature key `key`, and the angle (radians) about the reference
+  /// normal that turns the pair's other point into the half-plane y >= 0, z = 0 of the reference's frame.
+  struct Entry {
+    uint32_t reference;
+    float alpha;
+  };
+  const std::vector<Entry>* Find(uint32_t key) const;
+
+ private:
+  std::vector<OrientedPoint> points_;
+  double diameter_m_;
+  PpfOptions options_;
+  std::unordered_map<uint32_t, std::vector<Entry>> table_;
+  size_t pairs_ = 0;
+};
+
+/// A pose hypothesis of a model in a scene.
+struct PpfPose {
+  Eigen::Isometry3d camera_from_object = Eigen::Isometry3d::Identity();
+  double votes = 0.0;  ///< the cluster's votes
+};
+
+/// The model's best pose clusters among `scene` points (camera frame, normals towards the camera), most votes first.
+std::vector<PpfPose> FindPpfPoses(const PpfModel& model, const std::vector<OrientedPoint>& scene);
+
+}  // namespace ecv
