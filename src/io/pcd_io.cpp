@@ -1,6 +1,8 @@
 // Organized point clouds through PCL's io (kept in this one file: PCL headers are slow to compile).
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <limits>
 
@@ -12,6 +14,34 @@
 #include "io/points_io.h"
 
 namespace ecv {
+namespace {
+
+// The file's points as PCL stores them, checked before PCL converts them: as many as WIDTH x HEIGHT, each of
+// POINT_STEP bytes, every field inside a point. PCL trusts the header and would index past its data otherwise.
+template <typename Point>
+pcl::PointCloud<Point> ReadCheckedCloud(const std::string& path, pcl::PCDReader& reader) {
+  pcl::PCLPointCloud2 blob;
+  if (reader.read(path, blob) < 0) ThrowInputError(path, "DATA", "readable point data");
+  const uint64_t count = static_cast<uint64_t>(blob.width) * blob.height;
+  if (count == 0) ThrowInputError(path, "POINTS", "at least one point", "none");
+  if (blob.point_step == 0 || blob.data.size() != count * blob.point_step) {
+    ThrowInputError(path, "DATA", "WIDTH x HEIGHT points of POINT_STEP bytes each",
+                    std::to_string(blob.data.size()) + " bytes for " + std::to_string(count) + " points");
+  }
+  for (const pcl::PCLPointField& field : blob.fields) {
+    const uint64_t size = static_cast<uint64_t>(pcl::getFieldSize(field.datatype)) * std::max(field.count, 1U);
+    if (size == 0 || field.offset + size > blob.point_step) {
+      ThrowInputError(path, "FIELDS", "fields that fit in a point", "field " + field.name + " does not");
+    }
+  }
+  pcl::PointCloud<Point> cloud;
+  pcl::fromPCLPointCloud2(blob, cloud);
+  if (cloud.size() != count)
+    ThrowInputError(path, "DATA", std::to_string(count) + " points", std::to_string(cloud.size()));
+  return cloud;
+}
+
+}  // namespace
 
 void ReadOrganizedPcd(const std::string& path, cv::Mat* points, cv::Mat* color) {
   if (!std::filesystem::exists(path)) ThrowInputError(path, "point cloud", "an existing .pcd file", "no such file");
@@ -32,8 +62,7 @@ void ReadOrganizedPcd(const std::string& path, cv::Mat* points, cv::Mat* color) 
                     std::to_string(header.height));
   }
 
-  pcl::PointCloud<pcl::PointXYZRGBA> cloud;
-  if (reader.read(path, cloud) < 0) ThrowInputError(path, "DATA", "readable point data");
+  const pcl::PointCloud<pcl::PointXYZRGBA> cloud = ReadCheckedCloud<pcl::PointXYZRGBA>(path, reader);
   const int width = static_cast<int>(cloud.width), height = static_cast<int>(cloud.height);
   points->create(height, width, CV_32FC3);
   color->create(height, width, CV_8UC3);
@@ -55,8 +84,7 @@ std::vector<Eigen::Vector3f> ReadPcdPoints(const std::string& path) {
   for (const pcl::PCLPointField& field : header.fields)
     xyz += field.name == "x" || field.name == "y" || field.name == "z";
   if (xyz != 3) ThrowInputError(path, "FIELDS", "x, y and z");
-  pcl::PointCloud<pcl::PointXYZ> cloud;
-  if (reader.read(path, cloud) < 0) ThrowInputError(path, "DATA", "readable point data");
+  const pcl::PointCloud<pcl::PointXYZ> cloud = ReadCheckedCloud<pcl::PointXYZ>(path, reader);
   std::vector<Eigen::Vector3f> points;
   points.reserve(cloud.size());
   for (const pcl::PointXYZ& p : cloud) {

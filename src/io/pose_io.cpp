@@ -48,8 +48,9 @@ nlohmann::json ReadJsonFile(const std::string& path) {
   if (!stream) ThrowInputError(path, "JSON file", "a readable file");
   try {
     return nlohmann::json::parse(stream);
-  } catch (const nlohmann::json::parse_error& error) {
-    // error.what() gives "[json.exception.parse_error.101] parse error at line L, column C: ...".
+  } catch (const nlohmann::json::exception& error) {
+    // error.what() gives "[json.exception.parse_error.101] parse error at line L, column C: ..." (or a number out of
+    // range: out_of_range.406).
     ThrowInputError(path, "JSON", "well-formed JSON", error.what());
   }
 }

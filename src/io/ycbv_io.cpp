@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <memory>
 #include <vector>
 
@@ -113,7 +114,12 @@ LoadedFrame LoadYcbvFrame(const std::string& prefix) {
       for (int c = 0; c < 4; ++c) matrix(r, c) = poses.values[static_cast<size_t>(r + 3 * c) + 12 * n];
     }
     GroundTruth truth;
-    truth.object_id = static_cast<int>(classes.values[n]);
+    const double index = classes.values[n];
+    if (!(index >= 1.0 && index <= 21.0 && index == std::floor(index))) {
+      ThrowInputError(meta_path, "cls_indexes[" + std::to_string(n) + "]", "a class index in 1..21",
+                      std::to_string(index));
+    }
+    truth.object_id = static_cast<int>(index);
     truth.object_name = YcbvClassName(truth.object_id);
     truth.camera_from_object = RigidFromMatrix(matrix, meta_path, "poses[" + std::to_string(n) + "]");
     loaded.ground_truth.push_back(truth);

@@ -171,6 +171,7 @@ void PpfOptions::Check() const {
   require(distance_step > 0.0 && distance_step < 1.0, "distance_step", "a share of the diameter in (0, 1)");
   require(angle_bins >= 4 && angle_bins <= 180, "angle_bins", "4 to 180");
   require(keep_normal_deg > 0.0 && keep_normal_deg <= 180.0, "keep_normal_deg", "in (0, 180] degrees");
+  require(scene_keep_normal_deg > 0.0 && scene_keep_normal_deg <= 180.0, "scene_keep_normal_deg", "in (0, 180]");
   require(scene_reference_step >= 1, "scene_reference_step", "at least 1");
   require(poses_per_reference >= 1, "poses_per_reference", "at least 1");
   require(cluster_distance > 0.0, "cluster_distance", "> 0");
@@ -298,7 +299,7 @@ std::vector<PpfPose> FindPpfPoses(const PpfModel& model, const std::vector<Orien
   const PpfOptions& options = model.options();
   const double diameter = model.diameter_m();
   const std::vector<OrientedPoint> scene =
-      SubsampleByNormals(scene_points, options.sampling * diameter, options.keep_normal_deg);
+      SubsampleByNormals(scene_points, options.sampling * diameter, options.scene_keep_normal_deg);
   const FeatureBins bins(diameter, options);
   const CellGrid grid(scene, diameter);
   const size_t model_points = model.points().size();

@@ -20,10 +20,12 @@ struct OrientedPoint {
 /// (Sensors 2018): sub-sampling that keeps points of differing normals, votes spread to the neighbouring feature
 /// bins, each scene pair voting once per pose bin, and pose clustering. Steps are shares of the model's diameter.
 struct PpfOptions {
-  double sampling = 0.05;           ///< voxel of the model and scene sub-sampling, share of the diameter
-  double distance_step = 0.05;      ///< feature distance bin, share of the diameter (Drost's tau_d)
-  int angle_bins = 30;              ///< bins of each feature angle and of the rotation about the normal (12 degrees)
-  double keep_normal_deg = 30.0;    ///< a voxel keeps a second point whose normal differs by more than this
+  double sampling = 0.05;         ///< voxel of the model and scene sub-sampling, share of the diameter
+  double distance_step = 0.05;    ///< feature distance bin, share of the diameter (Drost's tau_d)
+  int angle_bins = 30;            ///< bins of each feature angle and of the rotation about the normal (12 degrees)
+  double keep_normal_deg = 30.0;  ///< a voxel keeps a second point whose normal differs by more than this
+  /// The same for the scene's voxels (180: one point per voxel; a depth image's normals are noisy).
+  double scene_keep_normal_deg = 30.0;
   int scene_reference_step = 5;     ///< every n-th sub-sampled scene point is a reference point
   bool spread_votes = true;         ///< also look up the neighbouring bin of each feature value near a bin border
   int poses_per_reference = 3;      ///< the best poses of each reference point kept for clustering

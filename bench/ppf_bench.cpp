@@ -1,0 +1,107 @@
+// Point pair features alone (src/registration/ppf.h): for every ground-truth object of the 30 YCB-Video frames of
+// ../shared/data, the rank of the first pose cluster within 2 cm and 15 degrees of the truth among the best 20, and
+// the time per model and frame, under the settings given.
+//
+//   ppf_bench [--stride 2] [--step 5] [--coplanar 12] [--scene-normals 30] [--frames 000001] [--results F]
+
+#include <CLI/CLI.hpp>
+
+#include <iostream>
+#include <map>
+#include <sstream>
+
+#include "bench_util.h"
+#include "core/pose.h"
+#include "core/timing.h"
+#include "io/frame_io.h"
+#include "io/mesh_io.h"
+#include "registration/icp.h"
+#include "registration/ppf.h"
+
+namespace ecv::bench {
+namespace {
+
+// The frame's depth samples every `stride` pixels with their normals turned towards the camera.
+std::vector<OrientedPoint> ScenePoints(const RgbdFrame& frame, int stride) {
+  const OrganizedScene organized = MakeOrganizedScene(frame.depth, frame.camera, stride);
+  std::vector<OrientedPoint> points;
+  for (int v = 0; v < organized.points.rows; ++v) {
+    for (int u = 0; u < organized.points.cols; ++u) {
+      const cv::Vec3f p = organized.points.at<cv::Vec3f>(v, u), n = organized.normals.at<cv::Vec3f>(v, u);
+      if (p[2] <= 0.0F || (n[0] == 0.0F && n[1] == 0.0F && n[2] == 0.0F)) continue;
+      OrientedPoint point{{p[0], p[1], p[2]}, Eigen::Vector3f(n[0], n[1], n[2]).normalized()};
+      if (point.normal.dot(point.position) > 0.0F) point.normal = -point.normal;
+      points.push_back(point);
+    }
+  }
+  return points;
+}
+
+int Run(int argc, char** argv) {
+  CLI::App app{"ppf_bench: point pair features alone on the YCB-Video frames' ground-truth objects"};
+  PpfOptions options;
+  int stride = 2;
+  std::string frames_filter, results = std::string(ECV_SOURCE_DIR) + "/bench/RESULTS.md";
+  options.coplanar_deg = 12.0;
+  app.add_option("--stride", stride, "Scene depth samples every N pixels")->capture_default_str();
+  app.add_option("--step", options.scene_reference_step, "Every N-th sub-sampled scene point is a reference")
+      ->capture_default_str();
+  app.add_option("--coplanar", options.coplanar_deg, "Pairs of one plane within this angle are skipped (degrees)")
+      ->capture_default_str();
+  app.add_option("--scene-normals", options.scene_keep_normal_deg,
+                 "A scene voxel keeps a second point whose normal differs by more (180: one per voxel)")
+      ->capture_default_str();
+  app.add_option("--frames", frames_filter, "Only frames whose name contains this (default: all 30)");
+  app.add_option("--results", results, "Markdown file the report is appended to")->capture_default_str();
+  if (const auto exit_code = ParseCommandLine(app, argc, argv)) return *exit_code;
+
+  std::map<std::string, PpfModel> models;
+  std::ostringstream table;
+  table << "| frame | object | rank | error mm / deg | ms |\n|---|---|---:|---|---:|\n";
+  int found = 0, objects = 0;
+  std::vector<double> times;
+  for (const std::string& prefix : YcbvFramePrefixes(ECV_DATA_DIR)) {
+    if (!frames_filter.empty() && prefix.find(frames_filter) == std::string::npos) continue;
+    const LoadedFrame loaded = LoadYcbvFrame(prefix);
+    const std::vector<OrientedPoint> scene = ScenePoints(loaded.rgbd, stride);
+    const std::string frame = prefix.substr(prefix.size() - 11);
+    for (const GroundTruth& truth : loaded.ground_truth) {
+      if (models.count(truth.object_name) == 0) {
+        MeshLoadOptions load;
+        load.allow_missing_textures = true;
+        const TriangleMesh mesh = LoadMesh(
+            std::string(ECV_DATA_DIR) + "/ycbv_subset/models/" + truth.object_name + "/textured_simple.obj", load);
+        models.emplace(truth.object_name, PpfModel(SampleMeshSurface(mesh, 20000), mesh.Diameter(), options));
+      }
+      const Clock::time_point start = Clock::now();
+      const std::vector<PpfPose> poses = FindPpfPoses(models.at(truth.object_name), scene);
+      const double ms = MillisecondsSince(start);
+      times.push_back(ms);
+      int rank = -1;
+      double mm = 0.0, deg = 0.0;
+      for (size_t i = 0; i < poses.size() && rank < 0; ++i) {
+        mm = TranslationDistance(poses[i].camera_from_object, truth.camera_from_object) * 1000.0;
+        deg = RotationAngle(poses[i].camera_from_object, truth.camera_from_object) * 180.0 / M_PI;
+        if (mm < 20.0 && deg < 15.0) rank = static_cast<int>(i);
+      }
+      ++objects;
+      found += rank == 0 ? 1 : 0;
+      table << "| " << frame << " | " << truth.object_name << " | " << rank << " | "
+            << (rank >= 0 ? Fixed(mm, 0) + " / " + Fixed(deg, 0) : "") << " | " << Fixed(ms, 0) << " |\n";
+      std::cerr << frame << ' ' << truth.object_name << " rank " << rank << ", " << Fixed(ms, 0) << " ms\n";
+    }
+  }
+  std::ostringstream report;
+  report << "Best cluster right (within 2 cm and 15 degrees) for " << found << " of " << objects << " objects; median "
+         << Fixed(Median(times), 0) << " ms per model and frame (one thread).\n\n"
+         << table.str();
+  Report(results, "Point pair features alone on YCB-Video (ppf_bench)", CommandLine(argc, argv), report.str());
+  return 0;
+}
+
+}  // namespace
+}  // namespace ecv::bench
+
+int main(int argc, char** argv) {
+  return ecv::bench::Run(argc, argv);
+}
