@@ -128,6 +128,13 @@ cv::Mat ReadTexture(BlobReader& reader, bool decode) {
     ThrowInputError(reader.source(), "texture size", "1 to 32768 pixels a side",
                     std::to_string(width) + " x " + std::to_string(height));
   }
+  // LZ4 packs at most about 255 bytes into one: a texture that claims more pixels than its bytes can hold is
+  // refused before its pixels are allocated.
+  if (static_cast<uint64_t>(width) * height * 3 > 255ULL * size + 64) {
+    ThrowInputError(reader.source(), "texture",
+                    "LZ4 data of " + std::to_string(width) + " x " + std::to_string(height) + " RGB pixels",
+                    std::to_string(size) + " bytes, too few for them");
+  }
   cv::Mat rgb(static_cast<int>(height), static_cast<int>(width), CV_8UC3);
   const int raw = static_cast<int>(rgb.total() * 3);
   if (LZ4_decompress_safe(packed, reinterpret_cast<char*>(rgb.data), static_cast<int>(size), raw) != raw) {

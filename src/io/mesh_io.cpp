@@ -2,12 +2,15 @@
 
 #include "io/mesh_io.h"
 
+#include <poll.h>
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -194,7 +197,7 @@ bool WriteAll(int fd, const void* bytes, size_t size) {
 
 // ImportMesh in a child process: assimp trusts what files say, and a malformed one can crash it; a crash there
 // becomes an InputError naming the file.
-TriangleMesh ImportMeshIsolated(const std::string& path) {
+TriangleMesh ImportMeshIsolated(const std::string& path, double timeout_s) {
   int fds[2];
   if (pipe(fds) != 0) ThrowInputError(path, "mesh", "a pipe to read it through", std::strerror(errno));
   const pid_t child = fork();
@@ -210,7 +213,19 @@ TriangleMesh ImportMeshIsolated(const std::string& path) {
   close(fds[1]);
   std::string received;
   char buffer[1 << 16];
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  bool timed_out = false;
   for (;;) {
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    pollfd ready{fds[0], POLLIN, 0};
+    const int polled = left.count() > 0 ? poll(&ready, 1, static_cast<int>(left.count())) : 0;
+    if (polled < 0 && errno == EINTR) continue;
+    if (polled == 0) {  // the importer hangs on the file: it is ended
+      timed_out = true;
+      kill(child, SIGKILL);
+      break;
+    }
     const ssize_t got = read(fds[0], buffer, sizeof(buffer));
     if (got < 0 && errno == EINTR) continue;
     if (got <= 0) break;
@@ -219,6 +234,10 @@ TriangleMesh ImportMeshIsolated(const std::string& path) {
   close(fds[0]);
   int wait_status = 0;
   while (waitpid(child, &wait_status, 0) < 0 && errno == EINTR) {
+  }
+  if (timed_out) {
+    ThrowInputError(path, "mesh", "a file the mesh importer reads within " + std::to_string(timeout_s) + " s",
+                    "it took longer and was stopped");
   }
   if (WIFSIGNALED(wait_status)) {
     ThrowInputError(path, "mesh", "a file the mesh importer reads without crashing",
@@ -279,6 +298,9 @@ void MeshLoadOptions::Check() const {
     ThrowInputError("mesh options", "metres_per_unit", "a finite positive scale", std::to_string(metres_per_unit));
   }
   if (!object_from_mesh.matrix().allFinite()) ThrowInputError("mesh options", "object_from_mesh", "a finite transform");
+  if (!(import_timeout_s > 0.0)) {
+    ThrowInputError("mesh options", "import_timeout_s", "> 0 s", std::to_string(import_timeout_s));
+  }
 }
 
 double MetresPerUnit(const std::string& unit) {
@@ -322,7 +344,7 @@ TriangleMesh LoadMesh(const std::string& path, const MeshLoadOptions& options, s
   if (extension == ".ply") CheckPlyFile(path);
   if (extension == ".obj") CheckObjMaterials(path, options, warnings);
 
-  TriangleMesh mesh = ImportMeshIsolated(path);
+  TriangleMesh mesh = ImportMeshIsolated(path, options.import_timeout_s);
   const fs::path mesh_dir = fs::path(path).parent_path();
   for (MeshMaterial& material : mesh.materials) LoadTexture(mesh_dir, path, options, &material, warnings);
   if (mesh.NumTriangles() == 0) ThrowInputError(path, "faces", "a mesh with triangles", "no triangles");

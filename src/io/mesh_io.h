@@ -18,6 +18,9 @@ struct MeshLoadOptions {
   /// When a referenced texture file is missing, use vertex or material colours (with a warning) instead of
   /// failing.
   bool allow_missing_textures = false;
+  /// The importer reads the file in a child process; one that takes longer than this (seconds) is ended and the
+  /// file refused (a malformed file can make it loop).
+  double import_timeout_s = 120.0;
 
   void Check() const;
 };
@@ -26,8 +29,10 @@ struct MeshLoadOptions {
 double MetresPerUnit(const std::string& unit);
 
 /// Loads OBJ (+MTL and texture images), PLY (vertex colours), glTF/GLB and the other formats assimp
-/// reads. Throws InputError for a missing or unreadable file, a mesh without triangles, or a missing
-/// texture (unless allowed); `warnings` (may be null) receives what was tolerated.
+/// reads. PLY files are checked first (CheckPlyFile), and assimp reads the file in a child process, so that a crash,
+/// an exception or a hang of it becomes an error naming the file. Throws InputError for a missing, malformed or
+/// unreadable file, a mesh without triangles or with non-finite vertices, or a missing texture or material library
+/// (unless allowed); `warnings` (may be null) receives what was tolerated.
 TriangleMesh LoadMesh(const std::string& path, const MeshLoadOptions& options = {},
                       std::vector<std::string>* warnings = nullptr);
 

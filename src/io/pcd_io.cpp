@@ -20,6 +20,13 @@ namespace {
 // POINT_STEP bytes, every field inside a point. PCL trusts the header and would index past its data otherwise.
 template <typename Point>
 pcl::PointCloud<Point> ReadCheckedCloud(const std::string& path, pcl::PCDReader& reader) {
+  pcl::PCLPointCloud2 header;
+  if (reader.readHeader(path, header) < 0) ThrowInputError(path, "PCD header", "a valid PCD file");
+  // Every point takes at least a byte of the file: a header that claims more is refused before PCL allocates them.
+  const uint64_t claimed = static_cast<uint64_t>(header.width) * header.height;
+  if (claimed > std::filesystem::file_size(path)) {
+    ThrowInputError(path, "WIDTH x HEIGHT", "as many points as the file can hold", std::to_string(claimed));
+  }
   pcl::PCLPointCloud2 blob;
   if (reader.read(path, blob) < 0) ThrowInputError(path, "DATA", "readable point data");
   const uint64_t count = static_cast<uint64_t>(blob.width) * blob.height;

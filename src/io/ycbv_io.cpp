@@ -36,6 +36,17 @@ void AppendAs(const void* data, size_t count, std::vector<double>* out) {
 }
 
 MatArray ReadNumeric(mat_t* file, const std::string& path, const char* name) {
+  // The variable's header first: dimensions a meta file cannot have are refused before matio allocates for them.
+  constexpr double kMaxValues = 1e7;
+  {
+    std::unique_ptr<matvar_t, MatVarFreer> info(Mat_VarReadInfo(file, name));
+    if (!info) ThrowInputError(path, name, "a numeric variable", "none");
+    double values = 1.0;
+    for (int i = 0; i < info->rank; ++i) values *= static_cast<double>(info->dims[i]);
+    if (info->rank < 0 || info->rank > 8 || !(values <= kMaxValues)) {
+      ThrowInputError(path, name, "an array of at most 10^7 values", std::to_string(values));
+    }
+  }
   std::unique_ptr<matvar_t, MatVarFreer> variable(Mat_VarRead(file, name));
   if (!variable) ThrowInputError(path, name, "a numeric variable", "none");
   MatArray array;

@@ -120,6 +120,18 @@ TEST_F(MalformedMesh, AnImporterFailureOnAFileNotCheckedFirstNamesTheFile) {
   EXPECT_NE(message.find("mesh importer"), std::string::npos) << message;
 }
 
+// An importer that takes longer than MeshLoadOptions::import_timeout_s is ended and the file named (a malformed file
+// can make it loop); here a real mesh against a limit of a millisecond.
+TEST_F(MalformedMesh, AnImporterThatTakesTooLongIsEndedAndTheFileNamed) {
+  const std::string path = std::string(ECV_SOURCE_DIR) + "/models/meshes/003_cracker_box/003_cracker_box.obj";
+  MeshLoadOptions hurried;
+  hurried.import_timeout_s = 0.001;
+  const std::string message = Refusal(path, hurried);
+  EXPECT_NE(message.find(path), std::string::npos) << message;
+  EXPECT_NE(message.find("took longer"), std::string::npos) << message;
+  EXPECT_EQ(Refusal(path), "");  // the default limit reads it
+}
+
 TEST_F(MalformedMesh, AFileTheImporterCannotReadIsNamed) {
   const std::string path = Write("noise.obj", std::string("v 1 2\nf 7 8 9 10\n\x01\x02garbage", 24));
   const std::string message = Refusal(path);
