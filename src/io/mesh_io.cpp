@@ -4,6 +4,7 @@
 
 #include <poll.h>
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -207,6 +208,7 @@ TriangleMesh ImportMeshIsolated(const std::string& path, double timeout_s) {
     ThrowInputError(path, "mesh", "a process to read it in", std::strerror(errno));
   }
   if (child == 0) {
+    prctl(PR_SET_PDEATHSIG, SIGKILL);  // the importer dies with the process that waits for it
     close(fds[0]);
     ImportInChild(path, fds[1]);
   }

@@ -16,6 +16,19 @@
 namespace ecv {
 namespace {
 
+// Runs `read`, turning what PCL throws on a malformed file (e.g. std::out_of_range from its header parser) into an
+// InputError naming it.
+template <typename Read>
+auto WithPclErrors(const std::string& path, Read read) {
+  try {
+    return read();
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& error) {
+    ThrowInputError(path, "PCD", "a file PCL reads", error.what());
+  }
+}
+
 // The file's points as PCL stores them, checked before PCL converts them: as many as WIDTH x HEIGHT, each of
 // POINT_STEP bytes, every field inside a point. PCL trusts the header and would index past its data otherwise.
 template <typename Point>
@@ -24,8 +37,14 @@ pcl::PointCloud<Point> ReadCheckedCloud(const std::string& path, pcl::PCDReader&
   if (reader.readHeader(path, header) < 0) ThrowInputError(path, "PCD header", "a valid PCD file");
   // Every point takes at least a byte of the file: a header that claims more is refused before PCL allocates them.
   const uint64_t claimed = static_cast<uint64_t>(header.width) * header.height;
-  if (claimed > std::filesystem::file_size(path)) {
-    ThrowInputError(path, "WIDTH x HEIGHT", "as many points as the file can hold", std::to_string(claimed));
+  const uint64_t bytes = std::filesystem::file_size(path);
+  // Binary points take POINT_STEP bytes each; ASCII ones at least two per field; compressed ones LZF's at most
+  // ~100:1.
+  const uint64_t step = std::max<uint64_t>(header.point_step, 1);
+  if (claimed > bytes || step > (1U << 20) || claimed * step > 100 * bytes) {
+    ThrowInputError(path, "WIDTH x HEIGHT", "as many points as the file can hold",
+                    std::to_string(claimed) + " points of " + std::to_string(step) + " bytes in " +
+                        std::to_string(bytes) + " bytes");
   }
   pcl::PCLPointCloud2 blob;
   if (reader.read(path, blob) < 0) ThrowInputError(path, "DATA", "readable point data");
@@ -48,9 +67,7 @@ pcl::PointCloud<Point> ReadCheckedCloud(const std::string& path, pcl::PCDReader&
   return cloud;
 }
 
-}  // namespace
-
-void ReadOrganizedPcd(const std::string& path, cv::Mat* points, cv::Mat* color) {
+void ReadOrganizedPcdUnguarded(const std::string& path, cv::Mat* points, cv::Mat* color) {
   if (!std::filesystem::exists(path)) ThrowInputError(path, "point cloud", "an existing .pcd file", "no such file");
   pcl::PCLPointCloud2 header;
   pcl::PCDReader reader;
@@ -82,7 +99,7 @@ void ReadOrganizedPcd(const std::string& path, cv::Mat* points, cv::Mat* color) 
   }
 }
 
-std::vector<Eigen::Vector3f> ReadPcdPoints(const std::string& path) {
+std::vector<Eigen::Vector3f> ReadPcdPointsUnguarded(const std::string& path) {
   if (!std::filesystem::exists(path)) ThrowInputError(path, "point cloud", "an existing .pcd file", "no such file");
   pcl::PCLPointCloud2 header;
   pcl::PCDReader reader;
@@ -98,6 +115,19 @@ std::vector<Eigen::Vector3f> ReadPcdPoints(const std::string& path) {
     if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) points.emplace_back(p.x, p.y, p.z);
   }
   return points;
+}
+
+}  // namespace
+
+void ReadOrganizedPcd(const std::string& path, cv::Mat* points, cv::Mat* color) {
+  WithPclErrors(path, [&] {
+    ReadOrganizedPcdUnguarded(path, points, color);
+    return 0;
+  });
+}
+
+std::vector<Eigen::Vector3f> ReadPcdPoints(const std::string& path) {
+  return WithPclErrors(path, [&] { return ReadPcdPointsUnguarded(path); });
 }
 
 LoadedFrame LoadPcdFrame(const std::string& path) {

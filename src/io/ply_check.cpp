@@ -114,12 +114,21 @@ class PlyBody {
 // The header's format and elements; `body` is set to the offset of the first byte after "end_header\n".
 PlyFormat ReadHeader(const std::string& path, const std::string& bytes, std::vector<PlyElement>* elements,
                      size_t* body) {
-  const size_t end = bytes.find("end_header");
-  if (bytes.compare(0, 3, "ply") != 0 || end == std::string::npos) {
-    ThrowInputError(path, "PLY header", "'ply' ... 'end_header'");
+  // "end_header" as a line of its own, ending in \n (or \r\n).
+  size_t end = std::string::npos;
+  for (size_t at = bytes.find("\nend_header"); at != std::string::npos; at = bytes.find("\nend_header", at + 1)) {
+    const size_t after = at + 11;
+    if (after < bytes.size() &&
+        (bytes[after] == '\n' || (bytes[after] == '\r' && after + 1 < bytes.size() && bytes[after + 1] == '\n'))) {
+      end = at + 1;
+      break;
+    }
   }
-  const size_t newline = bytes.find('\n', end);
-  *body = newline == std::string::npos ? bytes.size() : newline + 1;
+  if (bytes.compare(0, 4, "ply\n") != 0 && bytes.compare(0, 5, "ply\r\n") != 0) {
+    ThrowInputError(path, "PLY header", "a first line 'ply'");
+  }
+  if (end == std::string::npos) ThrowInputError(path, "PLY header", "a line 'end_header'");
+  *body = bytes.find('\n', end) + 1;
   std::istringstream header(bytes.substr(0, end));
   std::string line, format_name;
   while (std::getline(header, line)) {
@@ -174,9 +183,14 @@ void CheckPlyFile(const std::string& path) {
   std::vector<PlyElement> elements;
   size_t body = 0;
   const PlyFormat format = ReadHeader(path, bytes, &elements, &body);
-  uint64_t vertices = 0;
+  uint64_t vertices = 0, faces = 0;
   for (const PlyElement& element : elements) {
     if (element.name == "vertex") vertices = element.count;
+    if (element.name == "face") faces = element.count;
+  }
+  if (vertices == 0 || faces == 0) {
+    ThrowInputError(path, "PLY header", "a mesh: elements vertex and face, each with a count above 0",
+                    std::to_string(vertices) + " vertices, " + std::to_string(faces) + " faces");
   }
   // Every value after the header, element by element; the face indices against the vertex count.
   PlyBody values(path, std::move(bytes), body, format);
