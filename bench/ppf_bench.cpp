@@ -15,27 +15,10 @@
 #include "core/timing.h"
 #include "io/frame_io.h"
 #include "io/mesh_io.h"
-#include "registration/icp.h"
 #include "registration/ppf.h"
 
 namespace ecv::bench {
 namespace {
-
-// The frame's depth samples every `stride` pixels with their normals turned towards the camera.
-std::vector<OrientedPoint> ScenePoints(const RgbdFrame& frame, int stride) {
-  const OrganizedScene organized = MakeOrganizedScene(frame.depth, frame.camera, stride);
-  std::vector<OrientedPoint> points;
-  for (int v = 0; v < organized.points.rows; ++v) {
-    for (int u = 0; u < organized.points.cols; ++u) {
-      const cv::Vec3f p = organized.points.at<cv::Vec3f>(v, u), n = organized.normals.at<cv::Vec3f>(v, u);
-      if (p[2] <= 0.0F || (n[0] == 0.0F && n[1] == 0.0F && n[2] == 0.0F)) continue;
-      OrientedPoint point{{p[0], p[1], p[2]}, Eigen::Vector3f(n[0], n[1], n[2]).normalized()};
-      if (point.normal.dot(point.position) > 0.0F) point.normal = -point.normal;
-      points.push_back(point);
-    }
-  }
-  return points;
-}
 
 int Run(int argc, char** argv) {
   CLI::App app{"ppf_bench: point pair features alone on the YCB-Video frames' ground-truth objects"};
@@ -63,7 +46,7 @@ int Run(int argc, char** argv) {
   for (const std::string& prefix : YcbvFramePrefixes(ECV_DATA_DIR)) {
     if (!frames_filter.empty() && prefix.find(frames_filter) == std::string::npos) continue;
     const LoadedFrame loaded = LoadYcbvFrame(prefix);
-    const std::vector<OrientedPoint> scene = ScenePoints(loaded.rgbd, stride);
+    const std::vector<OrientedPoint> scene = OrientedScenePoints(loaded.rgbd, stride);
     const std::string frame = prefix.substr(prefix.size() - 11);
     for (const GroundTruth& truth : loaded.ground_truth) {
       if (models.count(truth.object_name) == 0) {

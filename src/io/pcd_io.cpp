@@ -29,12 +29,12 @@ auto WithPclErrors(const std::string& path, Read read) {
   }
 }
 
-// The file's points as PCL stores them, checked before PCL converts them: as many as WIDTH x HEIGHT, each of
-// POINT_STEP bytes, every field inside a point. PCL trusts the header and would index past its data otherwise.
+// The file's points (its `header` read already) as PCL stores them, checked before PCL converts them: as many as WIDTH
+// x HEIGHT, each of POINT_STEP bytes, every field inside a point. PCL trusts the header and would index past its data
+// otherwise.
 template <typename Point>
-pcl::PointCloud<Point> ReadCheckedCloud(const std::string& path, pcl::PCDReader& reader) {
-  pcl::PCLPointCloud2 header;
-  if (reader.readHeader(path, header) < 0) ThrowInputError(path, "PCD header", "a valid PCD file");
+pcl::PointCloud<Point> ReadCheckedCloud(const std::string& path, const pcl::PCLPointCloud2& header,
+                                        pcl::PCDReader& reader) {
   // Every point takes at least a byte of the file: a header that claims more is refused before PCL allocates them.
   const uint64_t claimed = static_cast<uint64_t>(header.width) * header.height;
   const uint64_t bytes = std::filesystem::file_size(path);
@@ -86,7 +86,7 @@ void ReadOrganizedPcdUnguarded(const std::string& path, cv::Mat* points, cv::Mat
                     std::to_string(header.height));
   }
 
-  const pcl::PointCloud<pcl::PointXYZRGBA> cloud = ReadCheckedCloud<pcl::PointXYZRGBA>(path, reader);
+  const pcl::PointCloud<pcl::PointXYZRGBA> cloud = ReadCheckedCloud<pcl::PointXYZRGBA>(path, header, reader);
   const int width = static_cast<int>(cloud.width), height = static_cast<int>(cloud.height);
   points->create(height, width, CV_32FC3);
   color->create(height, width, CV_8UC3);
@@ -108,7 +108,7 @@ std::vector<Eigen::Vector3f> ReadPcdPointsUnguarded(const std::string& path) {
   for (const pcl::PCLPointField& field : header.fields)
     xyz += field.name == "x" || field.name == "y" || field.name == "z";
   if (xyz != 3) ThrowInputError(path, "FIELDS", "x, y and z");
-  const pcl::PointCloud<pcl::PointXYZ> cloud = ReadCheckedCloud<pcl::PointXYZ>(path, reader);
+  const pcl::PointCloud<pcl::PointXYZ> cloud = ReadCheckedCloud<pcl::PointXYZ>(path, header, reader);
   std::vector<Eigen::Vector3f> points;
   points.reserve(cloud.size());
   for (const pcl::PointXYZ& p : cloud) {

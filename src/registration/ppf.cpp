@@ -9,6 +9,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "registration/icp.h"
 
 namespace ecv {
 namespace {
@@ -259,6 +260,21 @@ std::vector<OrientedPoint> SampleMeshSurface(const TriangleMesh& mesh, int count
     samples.push_back(point);
   }
   return samples;
+}
+
+std::vector<OrientedPoint> OrientedScenePoints(const RgbdFrame& frame, int stride) {
+  const OrganizedScene organized = MakeOrganizedScene(frame.depth, frame.camera, stride);
+  std::vector<OrientedPoint> points;
+  for (int v = 0; v < organized.points.rows; ++v) {
+    for (int u = 0; u < organized.points.cols; ++u) {
+      const cv::Vec3f p = organized.points.at<cv::Vec3f>(v, u), n = organized.normals.at<cv::Vec3f>(v, u);
+      if (p[2] <= 0.0F || (n[0] == 0.0F && n[1] == 0.0F && n[2] == 0.0F)) continue;
+      OrientedPoint point{{p[0], p[1], p[2]}, Eigen::Vector3f(n[0], n[1], n[2]).normalized()};
+      if (point.normal.dot(point.position) > 0.0F) point.normal = -point.normal;
+      points.push_back(point);
+    }
+  }
+  return points;
 }
 
 PpfModel::PpfModel(const std::vector<OrientedPoint>& surface, double diameter_m, const PpfOptions& options)

@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 
+#include "core/frame.h"
 #include "core/mesh.h"
 
 namespace ecv {
@@ -48,6 +49,10 @@ std::vector<OrientedPoint> SubsampleByNormals(const std::vector<OrientedPoint>& 
 /// Points spread over a mesh's triangles, `count` of them in proportion to area (seeded), with the triangle's
 /// normal (turned by the vertex normals' side when the mesh has them).
 std::vector<OrientedPoint> SampleMeshSurface(const TriangleMesh& mesh, int count, uint64_t seed = 1);
+
+/// A frame's depth samples every `stride` pixels with their normals (MakeOrganizedScene), turned towards the camera;
+/// samples without a normal are left out.
+std::vector<OrientedPoint> OrientedScenePoints(const RgbdFrame& frame, int stride);
 
 /// A model's point pair table: every ordered pair of its sub-sampled points by quantized feature.
 class PpfModel {

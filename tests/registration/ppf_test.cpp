@@ -10,7 +10,6 @@
 #include "core/pose.h"
 #include "io/frame_io.h"
 #include "io/mesh_io.h"
-#include "registration/icp.h"
 #include "registration/ppf.h"
 #include "support/test_data.h"
 
@@ -18,24 +17,6 @@ namespace ecv {
 namespace {
 
 constexpr double kDegree = M_PI / 180.0;
-
-// The frame's depth samples every `stride` pixels with their normals turned towards the camera.
-std::vector<OrientedPoint> ScenePoints(const RgbdFrame& frame, int stride) {
-  const OrganizedScene organized = MakeOrganizedScene(frame.depth, frame.camera, stride);
-  std::vector<OrientedPoint> points;
-  for (int v = 0; v < organized.points.rows; ++v) {
-    for (int u = 0; u < organized.points.cols; ++u) {
-      const cv::Vec3f p = organized.points.at<cv::Vec3f>(v, u), n = organized.normals.at<cv::Vec3f>(v, u);
-      if (p[2] <= 0.0F || (n[0] == 0.0F && n[1] == 0.0F && n[2] == 0.0F)) continue;
-      OrientedPoint point;
-      point.position = {p[0], p[1], p[2]};
-      point.normal = Eigen::Vector3f(n[0], n[1], n[2]).normalized();
-      if (point.normal.dot(point.position) > 0.0F) point.normal = -point.normal;
-      points.push_back(point);
-    }
-  }
-  return points;
-}
 
 // A box of 12 x 8 x 5 cm, outward faces.
 TriangleMesh Box() {
@@ -105,7 +86,7 @@ TEST(Ppf, FindsTheBananaOfARealFrame) {
   PpfOptions options;
   options.coplanar_deg = 12.0;
   const PpfModel model(SampleMeshSurface(mesh, 20000), mesh.Diameter(), options);
-  const std::vector<PpfPose> poses = FindPpfPoses(model, ScenePoints(loaded.rgbd, 2));
+  const std::vector<PpfPose> poses = FindPpfPoses(model, OrientedScenePoints(loaded.rgbd, 2));
   ASSERT_FALSE(poses.empty());
   const GroundTruth* truth = nullptr;
   for (const GroundTruth& object : loaded.ground_truth) {
