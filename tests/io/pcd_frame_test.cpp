@@ -42,6 +42,15 @@ TEST(PcdFrame, ReadsDepthColourAndFitsIntrinsics) {
   EXPECT_EQ(valid, 241407);
   EXPECT_EQ(mismatched, 0);
   EXPECT_LT(worst, 0.5);
+
+  // The points and colours PCL 1.13's reader gives for this file: three pixels and the sums of each channel.
+  EXPECT_NEAR(points.at<cv::Vec3f>(240, 320)[2], 0.812F, 1e-6F);
+  EXPECT_NEAR(points.at<cv::Vec3f>(300, 100)[0], -0.291412F, 1e-6F);
+  EXPECT_EQ(color.at<cv::Vec3b>(240, 320), cv::Vec3b(78, 73, 47));
+  EXPECT_EQ(color.at<cv::Vec3b>(300, 100), cv::Vec3b(37, 39, 25));
+  EXPECT_EQ(color.at<cv::Vec3b>(200, 500), cv::Vec3b(101, 86, 78));
+  const cv::Scalar sums = cv::sum(color);
+  EXPECT_EQ(sums, cv::Scalar(24001028, 21760851, 19743536, 0));
 }
 
 }  // namespace
