@@ -326,6 +326,7 @@ struct Methods {
   int preselect = 0;    ///< > 0: ours also searching only this many pre-selected models (recognize --preselect)
   int threads = 1;      ///< > 1: ours also with this many worker threads (the same detections, faster)
   bool turned = false;  ///< ours also on the frames turned 180 degrees (a camera held upside down)
+  std::vector<std::string> hypotheses;  ///< ours also with these hypothesis sources (recognize --hypotheses)
 };
 
 // The `methods` on `frames` with the library at `db`.
@@ -364,6 +365,12 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
       preselecting.preselect.models = methods.preselect;
       runs.emplace_back(Preselecting(methods.preselect),
                         RunRecognizer(library, preselecting, frames, models, "preselect"));
+    }
+    for (const std::string& source : methods.hypotheses) {
+      RecognizerOptions sourced = options;
+      sourced.point_pairs.source = ParseHypothesisSource(source, "--hypotheses");
+      runs.emplace_back(std::string(kOurs) + ", --hypotheses " + source,
+                        RunRecognizer(library, sourced, frames, models, "hypotheses " + source));
     }
     if (methods.track) {
       runs.emplace_back(kTracking, RunRecognizer(library, options, frames, models, "track", true));
@@ -548,6 +555,9 @@ int main(int argc, char** argv) {
   app.add_option("--preselect", methods.preselect,
                  "Also run ours searching only the N models a quick look scores best (default: no such run)")
       ->check(AtLeastOne());
+  app.add_option("--hypotheses", methods.hypotheses,
+                 "Also run ours with these sources of pose hypotheses (ppf, both; recognize --hypotheses)")
+      ->check(CLI::IsMember({"context", "ppf", "both"}));
   app.add_flag("--turned", methods.turned, "Also run ours on the frames turned 180 degrees (ground truth moved)");
   app.add_option("--python", methods.python, "Python interpreter with Open3D for the Open3D peer")
       ->capture_default_str();

@@ -21,7 +21,8 @@ nlohmann::json RecognitionToJson(const RecognitionResult& result) {
                           {"contour_agreement", d.contour_agreement},
                           {"edge_agreement", d.edge_agreement},
                           {"edge_pixels", d.edge_pixels},
-                          {"tracked", d.tracked}});
+                          {"tracked", d.tracked},
+                          {"hypothesis", HypothesisSourceName(d.hypothesis)}});
   }
   return {{"detections", detections},
           {"timings_ms", result.timings_ms},
@@ -43,6 +44,13 @@ std::vector<Detection> DetectionsFromJson(const nlohmann::json& json, const std:
     detection.camera_from_object =
         PoseFromJson(item.value("camera_from_object", nlohmann::json()), source, field + ".camera_from_object");
     detection.score = item.value("score", 0.0);
+    if (item.contains("hypothesis")) {
+      const nlohmann::json& hypothesis = item["hypothesis"];
+      if (!hypothesis.is_string() || hypothesis == "both") {
+        ThrowInputError(source, field + ".hypothesis", "\"context\" or \"ppf\"", hypothesis.dump());
+      }
+      detection.hypothesis = ParseHypothesisSource(hypothesis.get<std::string>(), source + " " + field);
+    }
     detections.push_back(detection);
   }
   return detections;

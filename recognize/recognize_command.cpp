@@ -85,8 +85,9 @@ void PrintDetections(const LoadedFrame& loaded, const RecognitionResult& result)
               << d.depth_agreement << ", colour " << d.color_agreement << ", edges " << d.edge_agreement << " of "
               << d.edge_pixels << ", fit " << std::setprecision(1) << 1000.0 * d.surface_error_m << " mm"
               << std::setprecision(2) << ", outline " << d.contour_agreement << "), inliers " << d.inlier_fraction
-              << ", view " << d.view << ", t = [" << std::setprecision(3)
-              << d.camera_from_object.translation().transpose() << "] m" << std::setprecision(2) << '\n';
+              << ", view " << d.view << ", " << HypothesisSourceName(d.hypothesis) << (d.tracked ? ", tracked" : "")
+              << ", t = [" << std::setprecision(3) << d.camera_from_object.translation().transpose() << "] m"
+              << std::setprecision(2) << '\n';
     for (const GroundTruth& truth : loaded.ground_truth) {
       if (truth.object_name != d.model) continue;
       std::cout << "    vs ground truth: " << std::setprecision(1)
@@ -253,6 +254,17 @@ void AddSearchFlags(CLI::App& command, RecognizerOptions& options) {
       .add_option("--max-instances", options.max_instances,
                   "Instances of one model looked for per frame (e.g. a bin of identical parts)")
       ->capture_default_str();
+  command
+      .add_option_function<std::string>(
+          "--hypotheses",
+          [o = &options](const std::string& name) {
+            o->point_pairs.source = ParseHypothesisSource(name, "--hypotheses");
+          },
+          "Where poses come from: context (shape and appearance context descriptors, view ranking and RANSAC),\n"
+          "ppf (point pair features of the model's surface: shape alone) or both (point pairs for the models the\n"
+          "context does not find: objects that show a plain side)")
+      ->default_str(HypothesisSourceName(options.point_pairs.source))
+      ->check(CLI::IsMember({"context", "ppf", "both"}));
   command.add_option("--seed", options.ransac.seed, "Random seed")->capture_default_str();
   command
       .add_option("--threads", options.ransac.threads,

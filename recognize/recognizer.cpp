@@ -17,6 +17,7 @@
 #include "recognize/model_search.h"
 #include "recognize/scene.h"
 #include "recognize/verification.h"
+#include "registration/ppf.h"
 #include "render/renderer.h"
 #include "render/view_sampling.h"
 
@@ -60,6 +61,8 @@ class Recognizer::Impl {
     // (only a batch's meshes are held at once); the GL uploads on this thread, whose GL context it is.
     const size_t batch = static_cast<size_t>(options_.ransac.threads);
     std::vector<char> closed(models.size(), 0);  // per model: TriangleMesh::IsClosedOutward
+    ppf_models_.resize(models.size());
+    const bool point_pairs = options_.point_pairs.source != HypothesisSource::kContext;
     for (size_t first = 0; first < models.size(); first += batch) {
       std::vector<TriangleMesh> meshes(std::min(batch, models.size() - first));
       ParallelFor(meshes.size(), options_.ransac.threads, [&](size_t i) {
@@ -67,6 +70,7 @@ class Recognizer::Impl {
         meshes[i] = ModelMesh(models[first + i].record);
         records_[first + i].mesh_blob = {};  // the copy's bytes: the renderer holds the mesh
         closed[first + i] = meshes[i].IsClosedOutward() ? 1 : 0;
+        if (point_pairs) ppf_models_[first + i] = MakePointPairModel(meshes[i]);
       });
       for (const TriangleMesh& mesh : meshes) meshes_.push_back(renderer_.AddMesh(mesh));
     }
@@ -115,11 +119,12 @@ class Recognizer::Impl {
       times.Add(Stage::kTrack, MillisecondsSince(stage));
     }
     const int searched = ChooseModels(scope, &models);
-    if (searched > 0) {  // none when all are tracked
+    const bool context = options_.point_pairs.source != HypothesisSource::kPpf;
+    if (context && searched > 0) {  // none when all are tracked
       DescribeScene(library_.feature_settings(), options_, &scene, &times);
       result.scene_primitives = static_cast<int>(scene.primitives.size());
     }
-    if (options_.preselect.models > 0 && searched > options_.preselect.models) {
+    if (context && options_.preselect.models > 0 && searched > options_.preselect.models) {
       const Clock::time_point stage = Clock::now();
       Preselect(scene, &models);
       times.Add(Stage::kPreselect, MillisecondsSince(stage));
@@ -130,9 +135,12 @@ class Recognizer::Impl {
         static_cast<int>(std::count_if(models.begin(), models.end(), [](const ModelInFrame& m) { return m.search; }));
     const int ransac_threads = std::max(1, options_.ransac.threads / std::max(1, to_search));
     std::vector<ModelSearchResult> searches(models.size());
-    ParallelFor(models.size(), options_.ransac.threads, [&](size_t m) {
-      if (models[m].search) searches[m] = SearchModel(m, scene, ransac_threads, &models[m]);
-    });
+    if (context) {
+      ParallelFor(models.size(), options_.ransac.threads, [&](size_t m) {
+        if (models[m].search) searches[m] = SearchModel(m, scene, ransac_threads, &models[m]);
+      });
+    }
+    if (options_.point_pairs.source != HypothesisSource::kContext) SearchByPointPairs(scene, &models, &times);
     std::vector<Verified> candidates;
     for (size_t m = 0; m < models.size(); ++m) {
       times += searches[m].times;
@@ -273,6 +281,59 @@ class Recognizer::Impl {
       if (refined.detection.score >= best.detection.score) best = std::move(refined);
     }
     best.detection.tracked = true;
+    best.detection.hypothesis = prior.hypothesis;
+    return best;
+  }
+
+  // A model's point pair table from its mesh; none (the model gets no point pair hypotheses) when the mesh is too
+  // small, flat or coarse for point pairs.
+  std::optional<PpfModel> MakePointPairModel(const TriangleMesh& mesh) const {
+    try {
+      return PpfModel(SampleMeshSurface(mesh, options_.point_pairs.model_samples), mesh.Diameter(),
+                      options_.point_pairs.ppf);
+    } catch (const InputError&) {
+      return std::nullopt;
+    }
+  }
+
+  // Point pair hypotheses for every model still searched and not found (under kBoth: not found by the context), the
+  // models on the workers.
+  void SearchByPointPairs(const Scene& scene, std::vector<ModelInFrame>* models, StageTimes* times) {
+    std::vector<size_t> wanted;
+    for (size_t m = 0; m < models->size(); ++m) {
+      if ((*models)[m].search && (*models)[m].instances.empty() && ppf_models_[m]) wanted.push_back(m);
+    }
+    if (wanted.empty()) return;
+    const Clock::time_point start = Clock::now();
+    const std::vector<OrientedPoint> points = OrientedScenePoints(scene.organized);
+    ParallelFor(wanted.size(), options_.ransac.threads, [&](size_t i) {
+      std::optional<Verified> best = BestPointPairPose(wanted[i], scene, points);
+      if (best && Accepted(best->detection)) {
+        AddInstance(std::move(*best), options_.dense_stride_px, scene.frame->depth.size(), &(*models)[wanted[i]]);
+      }
+    });
+    times->Add(Stage::kPointPairs, MillisecondsSince(start));
+  }
+
+  // The model's best point pair pose clusters among the scene's oriented `points`, each verified, refined by ICP and
+  // verified again (the better kept); the best of them.
+  std::optional<Verified> BestPointPairPose(size_t model, const Scene& scene,
+                                            const std::vector<OrientedPoint>& points) {
+    const std::vector<PpfPose> poses = FindPpfPoses(*ppf_models_[model], points);
+    const ModelSearch search = Search(model, scene, 1);
+    std::optional<Verified> best;
+    for (size_t c = 0; c < poses.size() && c < static_cast<size_t>(options_.point_pairs.clusters); ++c) {
+      Hypothesis hypothesis;
+      hypothesis.pose = poses[c].camera_from_object;
+      Verified verified = Verify(model, scene, hypothesis);
+      if (options_.refine) {
+        search.Refine(verified.depth, &hypothesis);
+        Verified refined = Verify(model, scene, hypothesis);
+        if (refined.detection.score >= verified.detection.score) verified = std::move(refined);
+      }
+      verified.detection.hypothesis = HypothesisSource::kPpf;
+      if (!best || verified.detection.score > best->detection.score) best = std::move(verified);
+    }
     return best;
   }
 
@@ -362,7 +423,8 @@ class Recognizer::Impl {
   Renderer renderer_;
   std::mutex render_mutex_;  // Verify runs on the model workers
   std::vector<MeshId> meshes_;
-  std::vector<RenderOptions> render_options_;  // per model: shaded as its library views are
+  std::vector<RenderOptions> render_options_;        // per model: shaded as its library views are
+  std::vector<std::optional<PpfModel>> ppf_models_;  // per model, with point pair hypotheses: its table, if any
 };
 
 cv::Mat Recognizer::Impl::DrawDetections(const RgbdFrame& frame, const std::vector<Detection>& detections) {

@@ -37,6 +37,9 @@ struct Detection {
   double edge_agreement = 0.0;
   int edge_pixels = 0;   ///< ... and how many were predicted
   bool tracked = false;  ///< found from a prior (the previous frame's pose), without RANSAC
+  /// Where its pose came from: kContext (view ranking and RANSAC) or kPpf (point pair features); a tracked
+  /// detection keeps its first detection's.
+  HypothesisSource hypothesis = HypothesisSource::kContext;
 };
 
 /// Detections of one frame and where the time went.
@@ -59,11 +62,12 @@ struct RankedView {
 };
 
 /// The detections JSON that `ecvpose recognize --out-json` writes: {"detections": [{"model", "score",
-/// "camera_from_object", "inlier_fraction", "fit_error", "view", ...}], "timings_ms": {stage: ms}}.
+/// "camera_from_object", "inlier_fraction", "fit_error", "view", ..., "tracked", "hypothesis"}], "timings_ms":
+/// {stage: ms}}.
 nlohmann::json RecognitionToJson(const RecognitionResult& result);
 
-/// The detections of such JSON (model, score, camera_from_object); throws InputError naming `source` and the
-/// field when one is missing or malformed.
+/// The detections of such JSON (model, score, camera_from_object, hypothesis); throws InputError naming `source`
+/// and the field when one is missing or malformed.
 std::vector<Detection> DetectionsFromJson(const nlohmann::json& json, const std::string& source);
 
 /// A frame's descriptors as the recognizer computes them from its `primitives`: the library's `descriptor`

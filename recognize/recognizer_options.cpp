@@ -28,12 +28,37 @@ MatchOptions RecognizerOptions::DefaultMatch() {
   return options;
 }
 
+const char* HypothesisSourceName(HypothesisSource source) {
+  switch (source) {
+    case HypothesisSource::kContext: return "context";
+    case HypothesisSource::kPpf: return "ppf";
+    case HypothesisSource::kBoth: return "both";
+  }
+  return "context";
+}
+
+HypothesisSource ParseHypothesisSource(const std::string& name, const std::string& what) {
+  for (const HypothesisSource source : {HypothesisSource::kContext, HypothesisSource::kPpf, HypothesisSource::kBoth}) {
+    if (name == HypothesisSourceName(source)) return source;
+  }
+  ThrowInputError(what, "hypotheses", "context, ppf or both", "'" + name + "'");
+}
+
+PpfOptions PointPairOptions::DefaultPpf() {
+  PpfOptions options;
+  options.coplanar_deg = 12.0;  // a table top's pairs neither go into the tables nor vote
+  options.spread_margin = 0.25;
+  options.scene_reference_step = 10;
+  return options;
+}
+
 void RecognizerOptions::Check() const {
   match.Check();
   ransac.Check();
   icp.Check();
   verify.Check();
   ranking.consistency.Check();
+  point_pairs.ppf.Check();
   auto require = [](bool ok, const char* field, const char* expected) {
     if (!ok) ThrowInputError("recognizer options", field, expected);
   };
@@ -57,6 +82,8 @@ void RecognizerOptions::Check() const {
   require(max_overlap >= 0.0 && max_overlap <= 1.0, "max_overlap", "in [0, 1]");
   require(max_instances >= 1, "max_instances", "at least 1");
   require(later_instance_views >= 0, "later_instance_views", ">= 0 (0: views_per_model)");
+  require(point_pairs.clusters >= 1, "point_pairs.clusters", "at least 1");
+  require(point_pairs.model_samples >= 100, "point_pairs.model_samples", "at least 100");
 }
 
 }  // namespace ecv

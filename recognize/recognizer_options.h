@@ -4,6 +4,7 @@
 #include "recognize/scoring.h"
 #include "recognize/verification.h"
 #include "registration/icp.h"
+#include "registration/ppf.h"
 #include "registration/ransac.h"
 
 namespace ecv {
@@ -35,6 +36,26 @@ struct TrackingOptions {
   double min_start_score = 0.35;
 };
 
+/// Where pose hypotheses come from: the shape and appearance context descriptors (view ranking and RANSAC), point
+/// pair features of the model's surface (shape alone), or both, point pairs for the models the context did not find.
+enum class HypothesisSource { kContext, kPpf, kBoth };
+
+/// "context", "ppf" or "both".
+const char* HypothesisSourceName(HypothesisSource source);
+/// The source called `name`; throws InputError naming `what` otherwise.
+HypothesisSource ParseHypothesisSource(const std::string& name, const std::string& what);
+
+/// Shape-driven hypotheses: point pair features (registration/ppf.h) voted on the scene's depth samples (at
+/// dense_stride_px), the best pose clusters refined by ICP and verified as the context's poses are.
+struct PointPairOptions {
+  HypothesisSource source = HypothesisSource::kContext;
+  PpfOptions ppf = DefaultPpf();
+  int clusters = 5;           ///< the best pose clusters refined and verified per model
+  int model_samples = 20000;  ///< points spread over a model's mesh before sub-sampling
+
+  static PpfOptions DefaultPpf();
+};
+
 /// Settings of the online recognizer (paper Sect. III and IV-C, and what goes beyond it). bench/RESULTS.md,
 /// "Recognizer defaults", gives the measurements behind each default.
 struct RecognizerOptions {
@@ -47,6 +68,7 @@ struct RecognizerOptions {
   PreselectOptions preselect;
   VerifyOptions verify;
   TrackingOptions tracking;
+  PointPairOptions point_pairs;
 
   /// Views per model tried with RANSAC, the best ranked first.
   int views_per_model = 10;

@@ -19,8 +19,8 @@ StageTimes& StageTimes::operator+=(const StageTimes& other) {
 }
 
 std::map<std::string, double> StageTimes::Map() const {
-  static constexpr const char* kNames[kStages] = {"extract", "describe", "preselect", "track",  "rank",
-                                                  "match",   "ransac",   "refine",    "verify", "total"};
+  static constexpr const char* kNames[kStages] = {"extract", "describe", "preselect", "track",       "rank", "match",
+                                                  "ransac",  "refine",   "verify",    "point_pairs", "total"};
   std::map<std::string, double> map;
   for (size_t s = 0; s < kStages; ++s) {
     if (ran_[s]) map[kNames[s]] = ms_[s];
@@ -33,7 +33,7 @@ Scene PrepareScene(const RgbdFrame& frame, const RecognizerOptions& options) {
   scene.frame = &frame;
   scene.points = DepthPoints(frame, options.dense_stride_px);
   scene.verification = MakeVerificationFrame(frame, options.verify, options.dense_stride_px);
-  if (options.refine && options.projective_icp) {
+  if ((options.refine && options.projective_icp) || options.point_pairs.source != HypothesisSource::kContext) {
     scene.organized = MakeOrganizedScene(frame.depth, frame.camera, options.dense_stride_px);
   }
   scene.visibility.depth = frame.depth;

@@ -24,7 +24,20 @@
 namespace ecv {
 
 /// The stages of a frame's recognition, as RecognitionResult::timings_ms names them.
-enum class Stage { kExtract, kDescribe, kPreselect, kTrack, kRank, kMatch, kRansac, kRefine, kVerify, kTotal, kCount };
+enum class Stage {
+  kExtract,
+  kDescribe,
+  kPreselect,
+  kTrack,
+  kRank,
+  kMatch,
+  kRansac,
+  kRefine,
+  kVerify,
+  kPointPairs,
+  kTotal,
+  kCount
+};
 
 /// Milliseconds per stage; a stage never added to is absent from Map().
 class StageTimes {
@@ -53,7 +66,7 @@ struct Scene {
   std::vector<Eigen::Vector3f> ransac_points;
   std::unique_ptr<RadiusGrid> ransac_grid;
   VerificationFrame verification;
-  OrganizedScene organized;  ///< the depth samples with normals, for projective ICP
+  OrganizedScene organized;  ///< the depth samples with normals, for projective ICP and point pair hypotheses
   SceneVisibility visibility;
 };
 

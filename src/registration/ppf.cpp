@@ -7,6 +7,7 @@
 #include <cmath>
 #include <random>
 #include <string>
+#include <unordered_map>
 
 #include "core/error.h"
 #include "registration/icp.h"
@@ -37,9 +38,11 @@ Eigen::Matrix3f ToXAxis(const Eigen::Vector3f& normal) {
   return Eigen::AngleAxisf(std::atan2(sine, cosine), axis / sine).toRotationMatrix();
 }
 
-// The angle about x that turns `local` (a point in a reference point's frame) into the half-plane y >= 0, z = 0.
-float AlphaOf(const Eigen::Vector3f& local) {
-  return std::atan2(-local.z(), local.y());
+// The angle about x that turns `local` (a point in a reference point's frame) into the half-plane y >= 0, z = 0, in
+// 1/65536 turns from -pi (PpfModel::Entry::alpha).
+uint16_t AlphaOf(const Eigen::Vector3f& local) {
+  const float turns = (std::atan2(-local.z(), local.y()) + static_cast<float>(kPi)) / static_cast<float>(2.0 * kPi);
+  return static_cast<uint16_t>(static_cast<uint32_t>(std::lround(turns * 65536.0F)) & 0xffffU);
 }
 
 // Quantized features of a pair: the distance and the three angles, as bin positions (fractional) and the key.
@@ -50,7 +53,8 @@ class FeatureBins {
         angle_bins_(options.angle_bins),
         per_distance_(static_cast<float>(1.0 / (options.distance_step * diameter_m))),
         per_angle_(static_cast<float>(options.angle_bins / kPi)),
-        coplanar_(static_cast<float>(options.coplanar_deg * kPi / 180.0)) {}
+        coplanar_(static_cast<float>(options.coplanar_deg * kPi / 180.0)),
+        margin_(static_cast<float>(options.spread_margin)) {}
 
   // The pair's bin positions (distance, angle(n1, d), angle(n2, d), angle(n1, n2)); false when beyond the diameter
   // or coplanar (PpfOptions::coplanar_deg).
@@ -67,18 +71,22 @@ class FeatureBins {
     return true;
   }
 
+  // Keys run from 0 to NumKeys() - 1.
+  uint32_t NumKeys() const { return static_cast<uint32_t>(distance_bins_) * angle_bins_ * angle_bins_ * angle_bins_; }
+
   uint32_t Key(const int bins[4]) const {
     return ((static_cast<uint32_t>(bins[0]) * angle_bins_ + bins[1]) * angle_bins_ + bins[2]) * angle_bins_ + bins[3];
   }
 
-  // The pair's own key, and with `spread` also those with each value moved to its nearer neighbouring bin (up to 16).
+  // The pair's own key, and with `spread` also those with each value near a border (spread_margin) moved to the
+  // neighbouring bin across it (up to 16).
   int Keys(const float positions[4], bool spread, uint32_t keys[16]) const {
     int bins[4], other[4];
     for (int k = 0; k < 4; ++k) {
       const int limit = k == 0 ? distance_bins_ : angle_bins_;
       bins[k] = std::min(static_cast<int>(positions[k]), limit - 1);
       const float remainder = positions[k] - static_cast<float>(bins[k]);
-      other[k] = remainder < 0.5F ? bins[k] - 1 : bins[k] + 1;
+      other[k] = remainder < margin_ ? bins[k] - 1 : remainder > 1.0F - margin_ ? bins[k] + 1 : bins[k];
       if (other[k] < 0 || other[k] >= limit) other[k] = bins[k];
     }
     if (!spread) {
@@ -102,7 +110,7 @@ class FeatureBins {
  private:
   static constexpr float kHalfPi = static_cast<float>(kPi / 2.0);
   int distance_bins_, angle_bins_;
-  float per_distance_, per_angle_, coplanar_;
+  float per_distance_, per_angle_, coplanar_, margin_;
 };
 
 // Scene points by cells of one diameter, for the pairs of a reference point.
@@ -176,6 +184,7 @@ void PpfOptions::Check() const {
   require(scene_reference_step >= 1, "scene_reference_step", "at least 1");
   require(poses_per_reference >= 1, "poses_per_reference", "at least 1");
   require(cluster_distance > 0.0, "cluster_distance", "> 0");
+  require(spread_margin >= 0.0 && spread_margin <= 0.5, "spread_margin", "a share of a bin in [0, 0.5]");
   require(cluster_angle_deg > 0.0, "cluster_angle_deg", "> 0 degrees");
   require(max_poses >= 1, "max_poses", "at least 1");
   require(coplanar_deg >= 0.0 && coplanar_deg < 90.0, "coplanar_deg", "in [0, 90) degrees");
@@ -263,7 +272,10 @@ std::vector<OrientedPoint> SampleMeshSurface(const TriangleMesh& mesh, int count
 }
 
 std::vector<OrientedPoint> OrientedScenePoints(const RgbdFrame& frame, int stride) {
-  const OrganizedScene organized = MakeOrganizedScene(frame.depth, frame.camera, stride);
+  return OrientedScenePoints(MakeOrganizedScene(frame.depth, frame.camera, stride));
+}
+
+std::vector<OrientedPoint> OrientedScenePoints(const OrganizedScene& organized) {
   std::vector<OrientedPoint> points;
   for (int v = 0; v < organized.points.rows; ++v) {
     for (int u = 0; u < organized.points.cols; ++u) {
@@ -287,6 +299,7 @@ PpfModel::PpfModel(const std::vector<OrientedPoint>& surface, double diameter_m,
                     std::to_string(points_.size()));
   }
   const FeatureBins bins(diameter_m, options);
+  std::vector<std::pair<uint32_t, Entry>> keyed;  // every pair's key and entry, then sorted into the table by key
   for (size_t r = 0; r < points_.size(); ++r) {
     const Eigen::Matrix3f to_x = ToXAxis(points_[r].normal);
     for (size_t i = 0; i < points_.size(); ++i) {
@@ -295,20 +308,21 @@ PpfModel::PpfModel(const std::vector<OrientedPoint>& surface, double diameter_m,
       if (!bins.Positions(points_[r], points_[i], positions)) continue;
       uint32_t key[16];
       bins.Keys(positions, false, key);
-      const float alpha = AlphaOf(to_x * (points_[i].position - points_[r].position));
-      table_[key[0]].push_back({static_cast<uint32_t>(r), alpha});
-      ++pairs_;
+      keyed.push_back(
+          {key[0], {static_cast<uint32_t>(r), AlphaOf(to_x * (points_[i].position - points_[r].position))}});
     }
   }
+  pairs_ = keyed.size();
+  offsets_.assign(bins.NumKeys() + 1, 0);
+  for (const auto& [key, entry] : keyed) ++offsets_[key + 1];
+  for (size_t k = 1; k < offsets_.size(); ++k) offsets_[k] += offsets_[k - 1];
+  entries_.resize(keyed.size());
+  std::vector<uint32_t> next(offsets_.begin(), offsets_.end() - 1);
+  for (const auto& [key, entry] : keyed) entries_[next[key]++] = entry;
   if (pairs_ < 100) {
     ThrowInputError("point pair model", "surface", "a surface with relief (at least 100 pairs not in one plane)",
                     std::to_string(pairs_) + " pairs");
   }
-}
-
-const std::vector<PpfModel::Entry>* PpfModel::Find(uint32_t key) const {
-  const auto found = table_.find(key);
-  return found == table_.end() ? nullptr : &found->second;
 }
 
 std::vector<PpfPose> FindPpfPoses(const PpfModel& model, const std::vector<OrientedPoint>& scene_points) {
@@ -339,17 +353,14 @@ std::vector<PpfPose> FindPpfPoses(const PpfModel& model, const std::vector<Orien
       if (!bins.Positions(reference, other, positions)) return;
       uint32_t keys[16];
       const int count = bins.Keys(positions, options.spread_votes, keys);
-      const float alpha_scene = AlphaOf(to_x * (other.position - reference.position));
+      const uint16_t alpha_scene = AlphaOf(to_x * (other.position - reference.position));
       ++pair;
       for (int k = 0; k < count; ++k) {
-        const std::vector<PpfModel::Entry>* entries = model.Find(keys[k]);
-        if (entries == nullptr) continue;
-        for (const PpfModel::Entry& entry : *entries) {
-          float alpha = entry.alpha - alpha_scene;
-          if (alpha < -kPi) alpha += 2.0F * static_cast<float>(kPi);
-          if (alpha >= kPi) alpha -= 2.0F * static_cast<float>(kPi);
-          const int bin = std::min(static_cast<int>((alpha + kPi) / (2.0 * kPi) * angle_bins), angle_bins - 1);
-          const size_t cell = entry.reference * static_cast<size_t>(angle_bins) + static_cast<size_t>(bin);
+        const auto [begin, end] = model.Find(keys[k]);
+        for (const PpfModel::Entry* entry = begin; entry != end; ++entry) {
+          // alpha_model - alpha_scene, wrapped to a turn, from -pi: the rotation about x between the two frames.
+          const uint32_t turn = static_cast<uint16_t>(entry->alpha - alpha_scene + 32768U);
+          const size_t cell = entry->reference * static_cast<size_t>(angle_bins) + ((turn * angle_bins) >> 16);
           if (voted_by[cell] == pair) continue;
           voted_by[cell] = pair;
           ++accumulator[cell];

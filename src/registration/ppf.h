@@ -1,13 +1,14 @@
 #pragma once
 
 #include <cstdint>
-#include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
 
 #include "core/frame.h"
 #include "core/mesh.h"
+#include "registration/icp.h"
 
 namespace ecv {
 
@@ -29,6 +30,7 @@ struct PpfOptions {
   double scene_keep_normal_deg = 30.0;
   int scene_reference_step = 5;     ///< every n-th sub-sampled scene point is a reference point
   bool spread_votes = true;         ///< also look up the neighbouring bin of each feature value near a bin border
+  double spread_margin = 0.5;       ///< ... "near": within this share of a bin from the border (0.5: always)
   int poses_per_reference = 3;      ///< the best poses of each reference point kept for clustering
   double cluster_distance = 0.1;    ///< poses closer than this (share of the diameter) ...
   double cluster_angle_deg = 30.0;  ///< ... and turned less than this join one cluster
@@ -53,6 +55,8 @@ std::vector<OrientedPoint> SampleMeshSurface(const TriangleMesh& mesh, int count
 /// A frame's depth samples every `stride` pixels with their normals (MakeOrganizedScene), turned towards the camera;
 /// samples without a normal are left out.
 std::vector<OrientedPoint> OrientedScenePoints(const RgbdFrame& frame, int stride);
+/// The same of depth samples made already.
+std::vector<OrientedPoint> OrientedScenePoints(const OrganizedScene& organized);
 
 /// A model's point pair table: every ordered pair of its sub-sampled points by quantized feature.
 class PpfModel {
@@ -67,19 +71,26 @@ class PpfModel {
   const PpfOptions& options() const { return options_; }
   size_t NumPairs() const { return pairs_; }
 
-  /// The model reference point of every pair with feature key `key`, and the angle (radians) about the reference
-  /// normal that turns the pair's other point into the half-plane y >= 0, z = 0 of the reference's frame.
+  /// The model reference point of a pair, and the angle about the reference normal that turns the pair's other
+  /// point into the half-plane y >= 0, z = 0 of the reference's frame, as a turn share in 1/65536 (0: -pi): votes
+  /// subtract such angles with wrap-around, in integers.
   struct Entry {
     uint32_t reference;
-    float alpha;
+    uint16_t alpha;
   };
-  const std::vector<Entry>* Find(uint32_t key) const;
+  /// The pairs with feature key `key`, as [begin, end).
+  std::pair<const Entry*, const Entry*> Find(uint32_t key) const {
+    if (key + 1 >= offsets_.size()) return {nullptr, nullptr};
+    return {entries_.data() + offsets_[key], entries_.data() + offsets_[key + 1]};
+  }
 
  private:
   std::vector<OrientedPoint> points_;
   double diameter_m_;
   PpfOptions options_;
-  std::unordered_map<uint32_t, std::vector<Entry>> table_;
+  // The table: the entries of key k are entries_[offsets_[k], offsets_[k + 1]), one offset per possible key.
+  std::vector<uint32_t> offsets_;
+  std::vector<Entry> entries_;
   size_t pairs_ = 0;
 };
 
