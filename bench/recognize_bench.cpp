@@ -207,6 +207,23 @@ std::string RecallTable(const Runs& runs) {
     out << " **" << correct << " / " << present << " (" << Fixed(100.0 * correct / std::max(present, 1), 1)
         << " %)** |";
   }
+  // Recall per video (the part of a frame's name before '/'), when there are several.
+  std::map<std::string, std::map<std::string, std::pair<int, int>>> videos;  // video -> run -> (correct, present)
+  for (const auto& [label, run] : runs) {
+    for (const FrameEvaluation& frame : run.frames) {
+      auto& [correct, present] = videos[frame.frame.substr(0, frame.frame.find('/'))][label];
+      for (const ObjectEvaluation& object : frame.objects) {
+        correct += object.correct ? 1 : 0;
+        ++present;
+      }
+    }
+  }
+  for (const auto& [video, per_run] : videos) {
+    if (videos.size() < 2) break;
+    out << "\n| video " << video << " |";
+    for (const auto& [label, run] : runs)
+      out << ' ' << per_run.at(label).first << " / " << per_run.at(label).second << " |";
+  }
   out << "\n| false positives per frame |";
   for (const auto& [label, run] : runs) {
     out << ' ' << Fixed(static_cast<double>(false_positives[label]) / std::max<size_t>(run.frames.size(), 1), 2)
@@ -229,8 +246,8 @@ std::string RecallTable(const Runs& runs) {
 std::string TimingTable(const Run& run) {
   std::ostringstream out;
   out << "| stage | median ms per frame | mean ms per frame |\n|---|---:|---:|\n";
-  for (const char* stage :
-       {"extract", "describe", "track", "preselect", "rank", "match", "ransac", "verify", "refine", "total"}) {
+  for (const char* stage : {"extract", "describe", "track", "preselect", "rank", "match", "ransac", "point_pairs",
+                            "verify", "refine", "total"}) {
     const auto found = run.stage_ms.find(stage);
     if (found != run.stage_ms.end()) {
       out << "| " << stage << " | " << Fixed(Median(found->second), 1) << " | " << Fixed(Mean(found->second), 1)
@@ -327,6 +344,7 @@ struct Methods {
   int threads = 1;      ///< > 1: ours also with this many worker threads (the same detections, faster)
   bool turned = false;  ///< ours also on the frames turned 180 degrees (a camera held upside down)
   std::vector<std::string> hypotheses;  ///< ours also with these hypothesis sources (recognize --hypotheses)
+  std::vector<uint64_t> seeds;          ///< ours and the hypothesis runs repeated with each of these RANSAC seeds
 };
 
 // The `methods` on `frames` with the library at `db`.
@@ -345,6 +363,12 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
   RecognizerOptions options;
   if (methods.ours) {
     runs.emplace_back(kOurs, RunRecognizer(library, options, frames, models, "icp"));
+    for (const uint64_t seed : methods.seeds) {
+      RecognizerOptions seeded = options;
+      seeded.ransac.seed = seed;
+      runs.emplace_back(std::string(kOurs) + ", seed " + std::to_string(seed),
+                        RunRecognizer(library, seeded, frames, models, "seed " + std::to_string(seed)));
+    }
     if (methods.turned)
       runs.emplace_back(kTurned, RunRecognizer(library, options, TurnedFrames(frames), models, "turned"));
     if (methods.threads > 1) {
@@ -369,8 +393,13 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
     for (const std::string& source : methods.hypotheses) {
       RecognizerOptions sourced = options;
       sourced.point_pairs.source = ParseHypothesisSource(source, "--hypotheses");
-      runs.emplace_back(std::string(kOurs) + ", --hypotheses " + source,
-                        RunRecognizer(library, sourced, frames, models, "hypotheses " + source));
+      const std::string label = std::string(kOurs) + ", --hypotheses " + source;
+      runs.emplace_back(label, RunRecognizer(library, sourced, frames, models, "hypotheses " + source));
+      for (const uint64_t seed : methods.seeds) {
+        sourced.ransac.seed = seed;
+        runs.emplace_back(label + ", seed " + std::to_string(seed),
+                          RunRecognizer(library, sourced, frames, models, label + ", seed " + std::to_string(seed)));
+      }
     }
     if (methods.track) {
       runs.emplace_back(kTracking, RunRecognizer(library, options, frames, models, "track", true));
@@ -558,6 +587,8 @@ int main(int argc, char** argv) {
   app.add_option("--hypotheses", methods.hypotheses,
                  "Also run ours with these sources of pose hypotheses (ppf, both; recognize --hypotheses)")
       ->check(CLI::IsMember({"context", "ppf", "both"}));
+  app.add_option("--seeds", methods.seeds,
+                 "Also run ours (and each --hypotheses run) with these RANSAC seeds (the default run has seed 1)");
   app.add_flag("--turned", methods.turned, "Also run ours on the frames turned 180 degrees (ground truth moved)");
   app.add_option("--python", methods.python, "Python interpreter with Open3D for the Open3D peer")
       ->capture_default_str();
@@ -594,6 +625,11 @@ int main(int argc, char** argv) {
              << RecallTable(runs);
     if (methods.ours)
       markdown << "\nTime per frame, whole library (ECV + RANSAC + ICP):\n\n" << TimingTable(runs.front().second);
+    for (const std::string& source : methods.ours ? methods.hypotheses : std::vector<std::string>{}) {
+      markdown << "\nThe same with `--hypotheses " << source << "` (point_pairs: voting; verify and refine include the "
+               << "point pair poses'):\n\n"
+               << TimingTable(RunNamed(runs, std::string(kOurs) + ", --hypotheses " + source));
+    }
     if (methods.ours && methods.bytes) {
       markdown << "\nThe same matching with ByteNeighbours (`recognize --matcher bytes`: every scene descriptor "
                   "compared over 7-bit values, AVX-512 VNNI):\n\n"

@@ -297,38 +297,46 @@ class Recognizer::Impl {
   }
 
   // Point pair hypotheses for every model still searched and not found (under kBoth: not found by the context), the
-  // models on the workers.
+  // models on the workers. Adds the workers' times: voting (point_pairs), verification and ICP.
   void SearchByPointPairs(const Scene& scene, std::vector<ModelInFrame>* models, StageTimes* times) {
     std::vector<size_t> wanted;
     for (size_t m = 0; m < models->size(); ++m) {
       if ((*models)[m].search && (*models)[m].instances.empty() && ppf_models_[m]) wanted.push_back(m);
     }
     if (wanted.empty()) return;
-    const Clock::time_point start = Clock::now();
     const std::vector<OrientedPoint> points = OrientedScenePoints(scene.organized);
+    std::vector<StageTimes> model_times(wanted.size());
     ParallelFor(wanted.size(), options_.ransac.threads, [&](size_t i) {
-      std::optional<Verified> best = BestPointPairPose(wanted[i], scene, points);
+      std::optional<Verified> best = BestPointPairPose(wanted[i], scene, points, &model_times[i]);
       if (best && Accepted(best->detection)) {
         AddInstance(std::move(*best), options_.dense_stride_px, scene.frame->depth.size(), &(*models)[wanted[i]]);
       }
     });
-    times->Add(Stage::kPointPairs, MillisecondsSince(start));
+    for (const StageTimes& model : model_times) *times += model;
   }
 
   // The model's best point pair pose clusters among the scene's oriented `points`, each verified, refined by ICP and
   // verified again (the better kept); the best of them.
-  std::optional<Verified> BestPointPairPose(size_t model, const Scene& scene,
-                                            const std::vector<OrientedPoint>& points) {
+  std::optional<Verified> BestPointPairPose(size_t model, const Scene& scene, const std::vector<OrientedPoint>& points,
+                                            StageTimes* times) {
+    Clock::time_point stage = Clock::now();
     const std::vector<PpfPose> poses = FindPpfPoses(*ppf_models_[model], points);
+    times->Add(Stage::kPointPairs, MillisecondsSince(stage));
     const ModelSearch search = Search(model, scene, 1);
     std::optional<Verified> best;
     for (size_t c = 0; c < poses.size() && c < static_cast<size_t>(options_.point_pairs.clusters); ++c) {
       Hypothesis hypothesis;
       hypothesis.pose = poses[c].camera_from_object;
+      stage = Clock::now();
       Verified verified = Verify(model, scene, hypothesis);
+      times->Add(Stage::kVerify, MillisecondsSince(stage));
       if (options_.refine) {
+        stage = Clock::now();
         search.Refine(verified.depth, &hypothesis);
+        times->Add(Stage::kRefine, MillisecondsSince(stage));
+        stage = Clock::now();
         Verified refined = Verify(model, scene, hypothesis);
+        times->Add(Stage::kVerify, MillisecondsSince(stage));
         if (refined.detection.score >= verified.detection.score) verified = std::move(refined);
       }
       verified.detection.hypothesis = HypothesisSource::kPpf;

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <map>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "core/error.h"
@@ -455,6 +456,10 @@ TEST_F(RecognizeEndToEnd, BadInputIsReported) {
   EXPECT_EQ(untracked.exit_code, 1) << untracked.output;
   EXPECT_NE(untracked.output.find("--search-every"), std::string::npos) << untracked.output;
   EXPECT_NE(untracked.output.find("--track"), std::string::npos) << untracked.output;
+  const test::CommandResult unknown_source =
+      test::RunCli("recognize --db " + library_ + " --hypotheses shape " + Frame());
+  EXPECT_EQ(unknown_source.exit_code, 2) << unknown_source.output;
+  EXPECT_NE(unknown_source.output.find("--hypotheses"), std::string::npos) << unknown_source.output;
 }
 
 // The library holds the meshes verification renders: a copy whose mesh paths lead nowhere recognises as the
@@ -565,6 +570,37 @@ TEST(RecognizerOptions, OutOfRangeValuesAreReportedByName) {
   options = RecognizerOptions();
   options.rival_min_ratio = -0.5;
   EXPECT_NE(message(options).find("rival_min_ratio"), std::string::npos) << message(options);
+  options = RecognizerOptions();
+  options.point_pairs.clusters = 0;
+  EXPECT_NE(message(options).find("point_pairs.clusters"), std::string::npos) << message(options);
+  options = RecognizerOptions();
+  options.point_pairs.ppf.spread_margin = 0.7;
+  EXPECT_NE(message(options).find("spread_margin"), std::string::npos) << message(options);
+}
+
+// Each detection's source of hypotheses survives the JSON; a source that is no detection's is refused by name.
+TEST(RecognitionJson, KeepsEachDetectionsHypothesisSource) {
+  RecognitionResult result;
+  result.detections.resize(2);
+  result.detections[0].model = "011_banana";
+  result.detections[0].hypothesis = HypothesisSource::kPpf;
+  result.detections[1].model = "006_mustard_bottle";
+  nlohmann::json json = RecognitionToJson(result);
+  EXPECT_EQ(json["detections"][0]["hypothesis"], "ppf");
+  EXPECT_EQ(json["detections"][1]["hypothesis"], "context");
+  const std::vector<Detection> read = DetectionsFromJson(json, "detections.json");
+  ASSERT_EQ(read.size(), 2U);
+  EXPECT_EQ(read[0].hypothesis, HypothesisSource::kPpf);
+  EXPECT_EQ(read[1].hypothesis, HypothesisSource::kContext);
+  json["detections"][0]["hypothesis"] = "both";
+  try {
+    DetectionsFromJson(json, "detections.json");
+    ADD_FAILURE() << "'both' read as a detection's source";
+  } catch (const InputError& error) {
+    EXPECT_THAT(error.what(), ::testing::HasSubstr("detections[0].hypothesis"));
+  }
+  EXPECT_EQ(ParseHypothesisSource("both", "--hypotheses"), HypothesisSource::kBoth);
+  EXPECT_THROW(ParseHypothesisSource("shape", "--hypotheses"), InputError);
 }
 
 // The scene's descriptors (ComputeSceneDescriptors) keep the library's settings but for the two caps: every n-th
