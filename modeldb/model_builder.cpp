@@ -54,7 +54,7 @@ PinholeCamera YcbVideoCamera() {
 
 ViewSamplingOptions ModelBuildOptions::DefaultSampling() {
   ViewSamplingOptions sampling;
-  sampling.num_views = 60;
+  sampling.num_views = 40;
   return sampling;
 }
 

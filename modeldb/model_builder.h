@@ -25,10 +25,11 @@ struct ModelBuildOptions {
   /// stay 0: the distance is `distance_m` below.
   ViewSamplingOptions sampling = DefaultSampling();
   /// Camera distance from the object centre, metres; farther when the object would not fit the image with the
-  /// margin; 0 = as close as it fits. 1 m is about where YCB-Video sees its objects: primitives then have the
+  /// margin; 0 = as close as it fits. 0.9 m is about where YCB-Video sees its objects: primitives then have the
   /// scene's density and image scale (as close as fits, small objects give dense views that take many times
-  /// longer to describe and store, and matched real frames worse: bench/RESULTS.md).
-  double distance_m = 1.0;
+  /// longer to describe and store, and matched real frames worse: bench/RESULTS.md). Every benchmark figure is
+  /// measured with this and DefaultSampling's 40 views.
+  double distance_m = 0.9;
   PinholeCamera camera = YcbVideoCamera();  ///< intrinsics and image size of every view (stored per view)
   RenderOptions render;                     ///< shading etc. (unlit: the texture's colours as stored)
   /// Beyond the paper: BuildModel renders a mesh without any texture (vertex or material colours only) with

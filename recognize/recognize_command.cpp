@@ -219,6 +219,8 @@ int RunRecognize(const RecognizeArgs& args) {
   const Clock::time_point setup = Clock::now();
   Recognizer recognizer(library, options);
   ReportSetup(library, options, MillisecondsSince(setup));
+  for (const std::string& warning : recognizer.PointPairWarnings())
+    std::cerr << "recognize: warning: " << warning << '\n';
   return single ? RecognizeOneFrame(args, *single, recognizer) : RecognizeSequence(args, frames, recognizer);
 }
 

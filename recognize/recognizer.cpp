@@ -62,6 +62,7 @@ class Recognizer::Impl {
     const size_t batch = static_cast<size_t>(options_.ransac.threads);
     std::vector<char> closed(models.size(), 0);  // per model: TriangleMesh::IsClosedOutward
     ppf_models_.resize(models.size());
+    ppf_refusals_.resize(models.size());
     const bool point_pairs = options_.point_pairs.source != HypothesisSource::kContext;
     for (size_t first = 0; first < models.size(); first += batch) {
       std::vector<TriangleMesh> meshes(std::min(batch, models.size() - first));
@@ -70,7 +71,7 @@ class Recognizer::Impl {
         meshes[i] = ModelMesh(models[first + i].record);
         records_[first + i].mesh_blob = {};  // the copy's bytes: the renderer holds the mesh
         closed[first + i] = meshes[i].IsClosedOutward() ? 1 : 0;
-        if (point_pairs) ppf_models_[first + i] = MakePointPairModel(meshes[i]);
+        if (point_pairs) ppf_models_[first + i] = MakePointPairModel(meshes[i], &ppf_refusals_[first + i]);
       });
       for (const TriangleMesh& mesh : meshes) meshes_.push_back(renderer_.AddMesh(mesh));
     }
@@ -156,6 +157,16 @@ class Recognizer::Impl {
   }
 
   cv::Mat DrawDetections(const RgbdFrame& frame, const std::vector<Detection>& detections);
+
+  std::vector<std::string> PointPairWarnings() const {
+    std::vector<std::string> warnings;
+    for (size_t m = 0; m < ppf_refusals_.size(); ++m) {
+      if (!ppf_refusals_[m].empty()) {
+        warnings.push_back("model " + records_[m].name + ": no point pair hypotheses (" + ppf_refusals_[m] + ")");
+      }
+    }
+    return warnings;
+  }
 
  private:
   std::optional<size_t> ModelIndex(const std::string& name) const {
@@ -285,13 +296,14 @@ class Recognizer::Impl {
     return best;
   }
 
-  // A model's point pair table from its mesh; none (the model gets no point pair hypotheses) when the mesh is too
-  // small, flat or coarse for point pairs.
-  std::optional<PpfModel> MakePointPairModel(const TriangleMesh& mesh) const {
+  // A model's point pair table from its mesh; none (the model gets no point pair hypotheses; `refusal` says why)
+  // when the mesh is too small, flat or coarse for point pairs.
+  std::optional<PpfModel> MakePointPairModel(const TriangleMesh& mesh, std::string* refusal) const {
     try {
       return PpfModel(SampleMeshSurface(mesh, options_.point_pairs.model_samples), mesh.Diameter(),
                       options_.point_pairs.ppf);
-    } catch (const InputError&) {
+    } catch (const InputError& error) {
+      *refusal = error.what();
       return std::nullopt;
     }
   }
@@ -433,6 +445,7 @@ class Recognizer::Impl {
   std::vector<MeshId> meshes_;
   std::vector<RenderOptions> render_options_;        // per model: shaded as its library views are
   std::vector<std::optional<PpfModel>> ppf_models_;  // per model, with point pair hypotheses: its table, if any
+  std::vector<std::string> ppf_refusals_;            // per model without a table: why
 };
 
 cv::Mat Recognizer::Impl::DrawDetections(const RgbdFrame& frame, const std::vector<Detection>& detections) {
@@ -463,6 +476,10 @@ RecognitionResult Recognizer::Recognize(const RgbdFrame& frame, const std::vecto
 
 std::map<std::string, std::vector<RankedView>> Recognizer::RankViews(const RgbdFrame& frame) {
   return impl_->RankViews(frame);
+}
+
+std::vector<std::string> Recognizer::PointPairWarnings() const {
+  return impl_->PointPairWarnings();
 }
 
 cv::Mat Recognizer::DrawDetections(const RgbdFrame& frame, const std::vector<Detection>& detections) {

@@ -109,6 +109,11 @@ class Recognizer {
   /// (RANSAC tries the first views_per_model of them).
   std::map<std::string, std::vector<RankedView>> RankViews(const RgbdFrame& frame);
 
+  /// With point pair hypotheses (RecognizerOptions::point_pairs): per model that has no point pair table, because
+  /// its mesh is too small, flat or coarse for point pairs, a line naming it and why; such a model is found by the
+  /// context alone.
+  std::vector<std::string> PointPairWarnings() const;
+
   /// `frame`'s colour image with each detected model rendered at its pose in red, outlined, with its name.
   cv::Mat DrawDetections(const RgbdFrame& frame, const std::vector<Detection>& detections);
 
