@@ -61,7 +61,6 @@ class Recognizer::Impl {
     // (only a batch's meshes are held at once); the GL uploads on this thread, whose GL context it is.
     const size_t batch = static_cast<size_t>(options_.ransac.threads);
     std::vector<char> closed(models.size(), 0);  // per model: TriangleMesh::IsClosedOutward
-    std::vector<char> single_colour(models.size(), 0);
     ppf_models_.resize(models.size());
     ppf_refusals_.resize(models.size());
     const bool point_pairs = options_.point_pairs.source != HypothesisSource::kContext;
@@ -72,7 +71,6 @@ class Recognizer::Impl {
         meshes[i] = ModelMesh(models[first + i].record);
         records_[first + i].mesh_blob = {};  // the copy's bytes: the renderer holds the mesh
         closed[first + i] = meshes[i].IsClosedOutward() ? 1 : 0;
-        single_colour[first + i] = meshes[i].IsSingleColoured() ? 1 : 0;
         if (point_pairs) ppf_models_[first + i] = MakePointPairModel(meshes[i], &ppf_refusals_[first + i]);
       });
       for (const TriangleMesh& mesh : meshes) meshes_.push_back(renderer_.AddMesh(mesh));
@@ -81,8 +79,6 @@ class Recognizer::Impl {
       RenderOptions& render = render_options_.emplace_back();
       render.shading = StoredViewShading(models[m].record.build_options_json);
       render.cull_back_faces = options_.verify.cull_back_faces && closed[m] != 0;
-      VerifyOptions& verify = verify_options_.emplace_back(options_.verify);
-      if (options_.verify.single_colour_by_edges && single_colour[m] != 0) verify.edge_weight = 1.0;
     }
   }
 
@@ -398,7 +394,7 @@ class Recognizer::Impl {
         MeasurePose({rendered.color, rendered.depth}, scene.verification, to_scene, options_.verify);
     Verified verified;
     Detection& detection = verified.detection;
-    ScorePose(evidence, verify_options_[model], &detection);
+    ScorePose(evidence, options_.verify, &detection);
     detection.model = library_model.record.name;
     detection.camera_from_object = hypothesis.pose;
     detection.inlier_fraction = hypothesis.ransac.inlier_fraction;
@@ -447,8 +443,7 @@ class Recognizer::Impl {
   Renderer renderer_;
   std::mutex render_mutex_;  // Verify runs on the model workers
   std::vector<MeshId> meshes_;
-  std::vector<RenderOptions> render_options_;  // per model: shaded as its library views are
-  std::vector<VerifyOptions> verify_options_;  // per model: options_.verify, but a one-coloured model's edge_weight
+  std::vector<RenderOptions> render_options_;        // per model: shaded as its library views are
   std::vector<std::optional<PpfModel>> ppf_models_;  // per model, with point pair hypotheses: its table, if any
   std::vector<std::string> ppf_refusals_;            // per model without a table: why
 };

@@ -37,9 +37,6 @@ struct VerifyOptions {
   /// (CompareEdges), colour alone when fewer than min_edge_pixels edges are predicted.
   double edge_weight = 0.5;
   int min_edge_pixels = 50;
-  /// A model of one colour (TriangleMesh::IsSingleColoured: a grey CAD model) predicts no print, so its colours
-  /// do not correlate with a real object's: its appearance is its edges alone (edge_weight 1).
-  bool single_colour_by_edges = true;
   EdgeOptions edge;
   double min_score = 0.3;             ///< poses below are not detections
   double min_visible_fraction = 0.1;  ///< nor poses of which the scene can show less than this share

@@ -5,7 +5,6 @@
 #include <cmath>
 #include <cstdint>
 #include <numeric>
-#include <optional>
 #include <utility>
 
 #include <opencv2/imgproc.hpp>
@@ -39,34 +38,6 @@ MeshColoring TriangleMesh::Coloring(const MeshPart& part) const {
   if (has_texture && !part.texcoords.empty()) return MeshColoring::kTexture;
   if (!part.colors.empty()) return MeshColoring::kVertexColor;
   return MeshColoring::kMaterialColor;
-}
-
-bool TriangleMesh::IsSingleColoured() const {
-  std::optional<Eigen::Vector3f> colour;
-  auto same = [&](const Eigen::Vector3f& next) {
-    if (colour && (next - *colour).cwiseAbs().maxCoeff() > 1.0F / 255.0F) return false;
-    colour = next;
-    return true;
-  };
-  for (const MeshPart& part : parts) {
-    if (part.triangles.empty()) continue;
-    switch (Coloring(part)) {
-      case MeshColoring::kTexture: return false;
-      case MeshColoring::kVertexColor:
-        for (const Eigen::Vector3f& vertex : part.colors) {
-          if (!same(vertex)) return false;
-        }
-        break;
-      case MeshColoring::kMaterialColor:
-        if (!same(part.material >= 0 && part.material < static_cast<int>(materials.size())
-                      ? materials[static_cast<size_t>(part.material)].diffuse_color
-                      : MeshMaterial().diffuse_color)) {
-          return false;
-        }
-        break;
-    }
-  }
-  return true;
 }
 
 Eigen::AlignedBox3d TriangleMesh::BoundingBox() const {

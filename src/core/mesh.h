@@ -50,10 +50,6 @@ struct TriangleMesh {
   /// vertex colours if present, else the material colour.
   MeshColoring Coloring(const MeshPart& part) const;
 
-  /// Whether the mesh shows one colour only: no texture, and every vertex colour and material colour used the same
-  /// (a CAD model in grey, say). Such a mesh predicts its form, not its print.
-  bool IsSingleColoured() const;
-
   /// Axis-aligned box of all vertices, metres; empty box for an empty mesh.
   Eigen::AlignedBox3d BoundingBox() const;
 

@@ -105,26 +105,5 @@ TEST(TriangleMesh, ColoringPrefersTextureThenVertexColours) {
   EXPECT_EQ(mesh.Coloring(mesh.parts[0]), MeshColoring::kTexture);
 }
 
-TEST(TriangleMesh, SingleColouredMeansOneMaterialColourWithoutTextureOrVertexColours) {
-  TriangleMesh mesh = Cube(1.0);
-  EXPECT_TRUE(mesh.IsSingleColoured());  // the default material colour
-  mesh.materials.push_back({"grey", {0.5F, 0.5F, 0.5F}, cv::Mat(), ""});
-  mesh.materials.push_back({"red", {0.9F, 0.1F, 0.1F}, cv::Mat(), ""});
-  mesh.parts[0].material = 0;
-  mesh.parts.push_back(mesh.parts[0]);
-  EXPECT_TRUE(mesh.IsSingleColoured());  // two parts, one colour
-  mesh.parts[1].material = 1;
-  EXPECT_FALSE(mesh.IsSingleColoured());  // two colours
-  mesh.parts.pop_back();
-  mesh.parts[0].colors.assign(8, Eigen::Vector3f(0.5F, 0.5F, 0.5F));
-  EXPECT_TRUE(mesh.IsSingleColoured());  // vertex colours, all one
-  mesh.parts[0].colors[3] = Eigen::Vector3f(0.5F, 0.6F, 0.5F);
-  EXPECT_FALSE(mesh.IsSingleColoured());  // vertex colours that differ
-  mesh.parts[0].colors.clear();
-  mesh.materials[0].texture = cv::Mat(4, 4, CV_8UC3, cv::Scalar(1, 2, 3));
-  mesh.parts[0].texcoords.assign(8, Eigen::Vector2f(0.5F, 0.5F));
-  EXPECT_FALSE(mesh.IsSingleColoured());  // a texture
-}
-
 }  // namespace
 }  // namespace ecv
