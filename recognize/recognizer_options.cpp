@@ -46,7 +46,7 @@ HypothesisSource ParseHypothesisSource(const std::string& name, const std::strin
 
 PpfOptions PointPairOptions::DefaultPpf() {
   PpfOptions options;
-  options.coplanar_deg = 12.0;  // a table top's pairs neither go into the tables nor vote
+  options.coplanar_deg = 12.0;   // a table top's pairs neither go into the tables nor vote
   options.spread_margin = 0.15;  // votes also in the neighbouring bin within 0.15 of a bin border
   return options;
 }
