@@ -28,17 +28,14 @@ constexpr std::array<const char*, 10> kKeywords = {"VERSION", "FIELDS", "SIZE", 
                                                    "WIDTH",   "HEIGHT", "VIEWPOINT", "POINTS", "DATA"};
 constexpr std::array<bool, 10> kOptional = {true, false, false, false, true, false, false, true, false, false};
 
-// `token` as a whole number in [1, max] (0 allowed when `allow_zero`), else an InputError naming `field`.
-uint64_t ParseCount(const std::string& path, const std::string& field, const std::string& token, uint64_t max,
-                    bool allow_zero = false) {
+// `token` as a whole number in [1, max], else an InputError naming `field`.
+uint64_t ParseCount(const std::string& path, const std::string& field, const std::string& token, uint64_t max) {
   uint64_t value = 0;
   bool digits = !token.empty() && token.size() <= 19;
   for (const char c : token) digits = digits && c >= '0' && c <= '9';
   if (digits) value = std::stoull(token);
-  if (!digits || value > max || (value == 0 && !allow_zero)) {
-    ThrowInputError(path, field,
-                    "a whole number from " + std::string(allow_zero ? "0" : "1") + " to " + std::to_string(max),
-                    "'" + token + "'");
+  if (!digits || value > max || value == 0) {
+    ThrowInputError(path, field, "a whole number from 1 to " + std::to_string(max), "'" + token + "'");
   }
   return value;
 }
