@@ -1,6 +1,7 @@
 // BOP scene images: SCENE_DIR/{scene_camera,scene_gt,scene_gt_info}.json, rgb/ (or gray/) and depth/
 // images named by the 6-digit image id. Depth in millimetres times depth_scale; poses in millimetres.
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 
@@ -38,6 +39,11 @@ std::vector<double> Numbers(const nlohmann::json& entry, const char* key, size_t
 
 cv::Rect Box(const nlohmann::json& entry, const char* key, const std::string& path) {
   const std::vector<double> box = Numbers(entry, key, 4, path);
+  for (const double value : box) {
+    if (!(std::abs(value) <= 1e6)) {  // also NaN; pixels of any real image
+      ThrowInputError(path, key, "4 pixel numbers (x, y, width, height) within +-1e6", std::to_string(value));
+    }
+  }
   return {static_cast<int>(box[0]), static_cast<int>(box[1]), static_cast<int>(box[2]), static_cast<int>(box[3])};
 }
 

@@ -1,12 +1,15 @@
 // Real LM-O image 3 (BOP layout), with its depth image from SAM-6D's example (see lmo_subset/SOURCE.md).
 
 #include <algorithm>
+#include <filesystem>
 
 #include <gtest/gtest.h>
 
+#include "core/error.h"
 #include "core/frame.h"
 #include "io/frame_io.h"
 #include "io/mesh_io.h"
+#include "io/pose_io.h"
 #include "support/test_data.h"
 
 namespace ecv {
@@ -40,6 +43,29 @@ TEST(BopFrame, ReadsLmoImageCameraAndEightPoses) {
   EXPECT_EQ(loaded.ground_truth[1].object_box, cv::Rect(376, 226, 60, 91));
   // Millimetres in scene_gt.json -> metres.
   EXPECT_NEAR(loaded.ground_truth[1].camera_from_object.translation().z(), 0.96478389285, 1e-9);
+}
+
+// A box far outside any image (the fuzzer's 1e300) is refused by name, not converted to int.
+TEST(BopFrame, ABoxBeyondAnyImageIsRefusedByName) {
+  const test::TemporaryDirectory directory;
+  const std::filesystem::path scene = directory.path() / "000002";
+  const std::filesystem::path source = test::DataPath("lmo_subset/data/bop/lmo/test/000002");
+  std::filesystem::create_directories(scene / "rgb");
+  for (const char* file : {"scene_camera.json", "scene_gt.json"}) std::filesystem::copy(source / file, scene / file);
+  std::filesystem::copy(source / "rgb" / "000003.png", scene / "rgb" / "000003.png");
+  nlohmann::json info = ReadJsonFile((source / "scene_gt_info.json").string());
+  info["3"][0]["bbox_obj"][0] = 1e300;
+  WriteJsonFile((scene / "scene_gt_info.json").string(), info);
+  FrameSpec spec;
+  spec.positional = scene.string() + ":3";
+  spec.depth_path = test::DataPath("lmo_subset/SAM-6D/Data/Example/depth.png");
+  try {
+    LoadFrame(spec);
+    ADD_FAILURE() << "a box at 1e300 was read";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("scene_gt_info.json"), std::string::npos) << error.what();
+    EXPECT_NE(std::string(error.what()).find("bbox_obj"), std::string::npos) << error.what();
+  }
 }
 
 TEST(BopFrame, AWrongDepthScaleIsWarnedAboutNamingTheFile) {
