@@ -2,6 +2,7 @@
 // images named by the 6-digit image id. Depth in millimetres times depth_scale; poses in millimetres.
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 
@@ -67,8 +68,9 @@ std::vector<GroundTruth> ReadBopGroundTruth(const std::string& scene_dir, int im
     const nlohmann::json& object = objects[i];
     const std::vector<double> r = Numbers(object, "cam_R_m2c", 9, gt_path);
     const std::vector<double> t = Numbers(object, "cam_t_m2c", 3, gt_path);
-    if (!object.contains("obj_id") || !object["obj_id"].is_number_integer()) {
-      ThrowInputError(gt_path, "obj_id", "an integer object id");
+    if (!object.contains("obj_id") || !object["obj_id"].is_number_integer() || object["obj_id"].get<int64_t>() < 0 ||
+        object["obj_id"].get<int64_t>() > 999999) {
+      ThrowInputError(gt_path, "obj_id", "an integer object id from 0 to 999999");
     }
     Eigen::Matrix4d matrix = Eigen::Matrix4d::Identity();
     for (int row = 0; row < 3; ++row) {
