@@ -43,6 +43,7 @@ std::vector<Detection> DetectionsFromJson(const nlohmann::json& json, const std:
     detection.model = item["model"].get<std::string>();
     detection.camera_from_object =
         PoseFromJson(item.value("camera_from_object", nlohmann::json()), source, field + ".camera_from_object");
+    if (item.contains("score") && !item["score"].is_number()) ThrowInputError(source, field + ".score", "a number");
     detection.score = item.value("score", 0.0);
     if (item.contains("hypothesis")) {
       const nlohmann::json& hypothesis = item["hypothesis"];

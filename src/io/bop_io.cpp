@@ -38,6 +38,13 @@ std::vector<double> Numbers(const nlohmann::json& entry, const char* key, size_t
   return values;
 }
 
+// `entry[key]` as a number, `fallback` when absent; an InputError naming `path` and `key` when it is not a number.
+double OptionalNumber(const nlohmann::json& entry, const char* key, double fallback, const std::string& path) {
+  if (!entry.is_object() || !entry.contains(key)) return fallback;
+  if (!entry[key].is_number()) ThrowInputError(path, key, "a number", entry[key].dump());
+  return entry[key].get<double>();
+}
+
 cv::Rect Box(const nlohmann::json& entry, const char* key, const std::string& path) {
   const std::vector<double> box = Numbers(entry, key, 4, path);
   for (const double value : box) {
@@ -84,7 +91,7 @@ std::vector<GroundTruth> ReadBopGroundTruth(const std::string& scene_dir, int im
     truth.object_name = name;
     truth.camera_from_object = RigidFromMatrix(matrix, gt_path, "cam_R_m2c");
     if (!info.empty()) {
-      truth.visible_fraction = info[i].value("visib_fract", -1.0);
+      truth.visible_fraction = OptionalNumber(info[i], "visib_fract", -1.0, info_path);
       truth.object_box = Box(info[i], "bbox_obj", info_path);
       truth.visible_box = Box(info[i], "bbox_visib", info_path);
     }
@@ -98,7 +105,7 @@ LoadedFrame LoadBopFrame(const std::string& scene_dir, int image_id, const std::
   const nlohmann::json camera_file = ReadJsonFile(camera_path);
   const nlohmann::json& camera = ImageEntry(camera_file, camera_path, image_id);
   const std::vector<double> k = Numbers(camera, "cam_K", 9, camera_path);
-  const double depth_scale_mm = camera.value("depth_scale", 1.0);  // millimetres = value * depth_scale
+  const double depth_scale_mm = OptionalNumber(camera, "depth_scale", 1.0, camera_path);  // mm = value * depth_scale
 
   std::string color_path = ImageFile(scene_dir, "rgb", image_id, ".png");
   for (const auto& [folder, extension] :
