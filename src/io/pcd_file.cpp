@@ -95,6 +95,11 @@ std::array<std::string, kKeywords.size()> ReadHeaderLines(const std::string& pat
   ThrowInputError(path, "DATA", "a DATA line ending the header", "none");
 }
 
+uint32_t LittleEndian32(const unsigned char* bytes) {
+  return static_cast<uint32_t>(bytes[0]) | static_cast<uint32_t>(bytes[1]) << 8 |
+         static_cast<uint32_t>(bytes[2]) << 16 | static_cast<uint32_t>(bytes[3]) << 24;
+}
+
 // Decompresses LZF data (a control byte below 32 starts a run of that many + 1 literal bytes; above, its top 3 bits
 // (7: plus the next byte) + 2 bytes are copied from 1 + its low 5 bits and the next byte back) into exactly
 // out->size() bytes; false if the data is not that.
@@ -257,13 +262,9 @@ PcdLayout CheckPcdFile(const std::string& path) {
     if (body_bytes < 8) refuse("the compressed and uncompressed sizes (8 bytes)", std::to_string(body_bytes));
     std::ifstream stream(path, std::ios::binary);
     stream.seekg(static_cast<std::streamoff>(layout.body_offset));
-    uint32_t compressed = 0, uncompressed = 0;  // little-endian, as PCL writes them
-    unsigned char raw[8];
+    unsigned char raw[8];  // the compressed and the uncompressed size, little-endian as PCL writes them
     if (!stream.read(reinterpret_cast<char*>(raw), 8)) refuse("8 bytes of sizes", "a read error");
-    for (int i = 3; i >= 0; --i) {
-      compressed = (compressed << 8) | raw[i];
-      uncompressed = (uncompressed << 8) | raw[4 + i];
-    }
+    const uint32_t compressed = LittleEndian32(raw), uncompressed = LittleEndian32(raw + 4);
     if (uncompressed != data_bytes) {
       refuse("an uncompressed size of " + std::to_string(data_bytes) + " bytes (POINTS x SIZE x COUNT)",
              std::to_string(uncompressed));
@@ -272,6 +273,7 @@ PcdLayout CheckPcdFile(const std::string& path) {
       refuse("a compressed size from 1 to the " + std::to_string(body_bytes - 8) + " bytes that follow",
              std::to_string(compressed));
     }
+    layout.compressed_bytes = compressed;
   }
   return layout;
 }
@@ -298,9 +300,8 @@ double PcdCloud::Value(uint64_t point, const PcdField& field, uint32_t element) 
 }
 
 uint32_t PcdCloud::Bits32(uint64_t point, const PcdField& field) const {
-  uint32_t raw;
-  std::memcpy(&raw, bytes.data() + point * layout.point_bytes + field.offset, 4);
-  return raw;
+  return LittleEndian32(reinterpret_cast<const unsigned char*>(bytes.data()) + point * layout.point_bytes +
+                        field.offset);
 }
 
 PcdCloud ReadPcdFile(const std::string& path) {
@@ -337,10 +338,8 @@ PcdCloud ReadPcdFile(const std::string& path) {
     return cloud;
   }
   // binary_compressed: two sizes, then LZF data holding each field's values for all points, field after field.
-  uint32_t compressed = 0;
-  for (int i = 3; i >= 0; --i) compressed = (compressed << 8) | static_cast<unsigned char>(body[i]);
   std::string by_field(cloud.bytes.size(), '\0');
-  if (!DecompressLzf(reinterpret_cast<const unsigned char*>(body.data()) + 8, compressed, &by_field)) {
+  if (!DecompressLzf(reinterpret_cast<const unsigned char*>(body.data()) + 8, layout.compressed_bytes, &by_field)) {
     ThrowInputError(path, "DATA binary_compressed",
                     "LZF data that decompresses to " + std::to_string(by_field.size()) + " bytes",
                     "data that does not");

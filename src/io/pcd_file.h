@@ -24,7 +24,8 @@ struct PcdLayout {
   uint64_t width = 0, height = 0;
   uint64_t point_bytes = 0;  // sum over the fields of SIZE x COUNT
   PcdData data = PcdData::kAscii;
-  uint64_t body_offset = 0;  // first byte after the DATA line
+  uint64_t body_offset = 0;       // first byte after the DATA line
+  uint64_t compressed_bytes = 0;  // binary_compressed: the LZF data's size, after the two 4-byte sizes
 
   uint64_t Points() const { return width * height; }
   /// The field called `name`, or nullptr.

@@ -33,7 +33,8 @@ void ReadOrganizedPcd(const std::string& path, cv::Mat* points, cv::Mat* color) 
   const PcdCloud cloud = ReadExisting(path);
   const PcdLayout& layout = cloud.layout;
   const std::array<const PcdField*, 3> xyz = XyzFields(path, layout);
-  const PcdField* rgb = layout.Find("rgba") != nullptr ? layout.Find("rgba") : layout.Find("rgb");
+  const PcdField* rgb = layout.Find("rgba");
+  if (rgb == nullptr) rgb = layout.Find("rgb");
   if (rgb == nullptr || rgb->size != 4 || rgb->count != 1) {
     ThrowInputError(path, "FIELDS", "x y z with a 4-byte rgb or rgba (a packed colour)");
   }
