@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <tuple>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -45,26 +47,61 @@ TEST(BopFrame, ReadsLmoImageCameraAndEightPoses) {
   EXPECT_NEAR(loaded.ground_truth[1].camera_from_object.translation().z(), 0.96478389285, 1e-9);
 }
 
-// A box far outside any image (the fuzzer's 1e300) is refused by name, not converted to int.
-TEST(BopFrame, ABoxBeyondAnyImageIsRefusedByName) {
-  const test::TemporaryDirectory directory;
+// The message of LoadFrame on a copy of LM-O scene 000002, image 3, in `directory` with each of its JSON files
+// changed by `edit` (file name, JSON); "" when it loads.
+template <typename Edit>
+std::string LoadEditedScene(const test::TemporaryDirectory& directory, Edit edit) {
   const std::filesystem::path scene = directory.path() / "000002";
   const std::filesystem::path source = test::DataPath("lmo_subset/data/bop/lmo/test/000002");
+  std::filesystem::remove_all(scene);
   std::filesystem::create_directories(scene / "rgb");
-  for (const char* file : {"scene_camera.json", "scene_gt.json"}) std::filesystem::copy(source / file, scene / file);
   std::filesystem::copy(source / "rgb" / "000003.png", scene / "rgb" / "000003.png");
-  nlohmann::json info = ReadJsonFile((source / "scene_gt_info.json").string());
-  info["3"][0]["bbox_obj"][0] = 1e300;
-  WriteJsonFile((scene / "scene_gt_info.json").string(), info);
+  for (const char* file : {"scene_camera.json", "scene_gt.json", "scene_gt_info.json"}) {
+    nlohmann::json json = ReadJsonFile((source / file).string());
+    edit(std::string(file), json);
+    WriteJsonFile((scene / file).string(), json);
+  }
   FrameSpec spec;
   spec.positional = scene.string() + ":3";
   spec.depth_path = test::DataPath("lmo_subset/SAM-6D/Data/Example/depth.png");
   try {
     LoadFrame(spec);
-    ADD_FAILURE() << "a box at 1e300 was read";
   } catch (const InputError& error) {
-    EXPECT_NE(std::string(error.what()).find("scene_gt_info.json"), std::string::npos) << error.what();
-    EXPECT_NE(std::string(error.what()).find("bbox_obj"), std::string::npos) << error.what();
+    return error.what();
+  }
+  return "";
+}
+
+// A box far outside any image (the fuzzer's 1e300) is refused by name, not converted to int.
+TEST(BopFrame, ABoxBeyondAnyImageIsRefusedByName) {
+  const test::TemporaryDirectory directory;
+  const std::string message = LoadEditedScene(directory, [](const std::string& file, nlohmann::json& json) {
+    if (file == "scene_gt_info.json") json["3"][0]["bbox_obj"][0] = 1e300;
+  });
+  EXPECT_NE(message.find("scene_gt_info.json"), std::string::npos) << message;
+  EXPECT_NE(message.find("bbox_obj"), std::string::npos) << message;
+}
+
+// Fields that hold the wrong kind of value are refused by file and name (a string where nlohmann's value() expected a
+// number threw past the reader; an object id beyond int's range was narrowed).
+TEST(BopFrame, NumbersOfTheWrongKindOrRangeAreRefusedByName) {
+  const test::TemporaryDirectory directory;
+  EXPECT_EQ(LoadEditedScene(directory, [](const std::string&, nlohmann::json&) {}), "");
+  const std::vector<std::tuple<std::string, std::string, nlohmann::json>> cases = {
+      {"scene_camera.json", "depth_scale", "1.0"},
+      {"scene_gt_info.json", "visib_fract", "high"},
+      {"scene_gt.json", "obj_id", 10000000000LL},
+      {"scene_gt.json", "obj_id", -1}};
+  for (const auto& [target, field, value] : cases) {
+    const std::string message = LoadEditedScene(directory, [&](const std::string& file, nlohmann::json& json) {
+      if (file != target) return;
+      if (field == "depth_scale")
+        json["3"][field] = value;
+      else
+        json["3"][0][field] = value;
+    });
+    EXPECT_NE(message.find(target), std::string::npos) << field << ": " << message;
+    EXPECT_NE(message.find(field), std::string::npos) << field << ": " << message;
   }
 }
 

@@ -599,6 +599,14 @@ TEST(RecognitionJson, KeepsEachDetectionsHypothesisSource) {
   } catch (const InputError& error) {
     EXPECT_THAT(error.what(), ::testing::HasSubstr("detections[0].hypothesis"));
   }
+  json["detections"][0]["hypothesis"] = "ppf";
+  json["detections"][0]["score"] = "high";
+  try {
+    DetectionsFromJson(json, "detections.json");
+    ADD_FAILURE() << "a score 'high' read";
+  } catch (const InputError& error) {
+    EXPECT_THAT(error.what(), ::testing::HasSubstr("detections[0].score"));
+  }
   EXPECT_EQ(ParseHypothesisSource("both", "--hypotheses"), HypothesisSource::kBoth);
   EXPECT_THROW(ParseHypothesisSource("shape", "--hypotheses"), InputError);
 }
