@@ -2,9 +2,11 @@
 
 #include "io/mesh_io.h"
 
+#include <dlfcn.h>
+#include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
-#include <sys/prctl.h>
+#include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -14,10 +16,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -34,6 +38,8 @@
 namespace ecv {
 namespace fs = std::filesystem;
 namespace {
+
+constexpr char kMeshImporterName[] = "ecvpose-mesh-import";
 
 std::string Lowercase(std::string text) {
   std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return std::tolower(c); });
@@ -172,9 +178,63 @@ bool WriteAll(int fd, const void* bytes, size_t size) {
   return true;
 }
 
-// The child's side: the mesh as a blob after 'M', or the error's message after 'E'; then _exit, so that nothing of
-// the parent's (buffers, atexit handlers) runs twice.
-[[noreturn]] void ImportInChild(const std::string& path, int fd) {
+// Where the mesh importer program is: $ECVPOSE_MESH_IMPORTER, else in the folder "ecvpose" beside the library (or
+// program) that holds this code, else where it was installed, else where it was built. Empty when none is there.
+std::string FindMeshImporter(std::vector<std::string>* tried) {
+  std::vector<std::string> candidates;
+  if (const char* chosen = std::getenv("ECVPOSE_MESH_IMPORTER"); chosen != nullptr && *chosen != '\0') {
+    candidates.emplace_back(chosen);
+  } else {
+    Dl_info self{};
+    if (dladdr(reinterpret_cast<void*>(&FindMeshImporter), &self) != 0 && self.dli_fname != nullptr) {
+      const fs::path beside = fs::path(self.dli_fname).parent_path() / "ecvpose" / kMeshImporterName;
+      candidates.push_back(beside.string());
+    }
+    candidates.emplace_back(ECV_MESH_IMPORTER_INSTALLED);
+    candidates.emplace_back(ECV_MESH_IMPORTER_BUILT);
+  }
+  for (const std::string& candidate : candidates) {
+    if (access(candidate.c_str(), X_OK) == 0 && !fs::is_directory(candidate)) return candidate;
+  }
+  *tried = candidates;
+  return {};
+}
+
+std::string MeshImporter() {
+  std::vector<std::string> tried;
+  std::string path = FindMeshImporter(&tried);
+  if (path.empty()) {
+    std::string list;
+    for (const std::string& candidate : tried) list += (list.empty() ? "" : ", ") + candidate;
+    throw std::runtime_error(std::string("the mesh importer program ") + kMeshImporterName +
+                             " is not where ecvpose looks for it (" + list +
+                             "): reinstall ecvpose, or set ECVPOSE_MESH_IMPORTER to its path");
+  }
+  return path;
+}
+
+// Starts the importer program on `path`, its standard output into `output` (the pipe's write end). posix_spawn, not
+// fork: a fork of a process whose other threads hold locks (the allocator's, under sanitizers) can hang the child.
+pid_t SpawnImporter(const std::string& path, int output) {
+  const std::string program = MeshImporter();
+  const std::string parent = std::to_string(getpid());
+  std::vector<char*> argv = {const_cast<char*>(program.c_str()), const_cast<char*>(path.c_str()),
+                             const_cast<char*>(parent.c_str()), nullptr};
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, output, STDOUT_FILENO);
+  pid_t child = -1;
+  const int failed = posix_spawn(&child, program.c_str(), &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (failed != 0) {
+    ThrowInputError(path, "mesh", "a process to read it in", program + ": " + std::strerror(failed));
+  }
+  return child;
+}
+
+}  // namespace
+
+int RunMeshImporter(const std::string& path, int fd) {
   char status = 'M';
   std::string payload;
   try {
@@ -193,24 +253,24 @@ bool WriteAll(int fd, const void* bytes, size_t size) {
   const uint64_t size = payload.size();
   const bool sent =
       WriteAll(fd, &status, 1) && WriteAll(fd, &size, sizeof(size)) && WriteAll(fd, payload.data(), payload.size());
-  _exit(sent ? 0 : 3);
+  return sent ? 0 : 3;
 }
 
-// ImportMesh in a child process: assimp trusts what files say, and a malformed one can crash it; a crash there
-// becomes an InputError naming the file.
+namespace {
+
+// ImportMesh in the importer program: assimp trusts what files say, and a malformed one can crash it or make it loop;
+// a crash or a hang there becomes an InputError naming the file.
 TriangleMesh ImportMeshIsolated(const std::string& path, double timeout_s) {
   int fds[2];
-  if (pipe(fds) != 0) ThrowInputError(path, "mesh", "a pipe to read it through", std::strerror(errno));
-  const pid_t child = fork();
-  if (child < 0) {
+  // Close-on-exec: an importer started by another thread meanwhile must not hold this pipe open.
+  if (pipe2(fds, O_CLOEXEC) != 0) ThrowInputError(path, "mesh", "a pipe to read it through", std::strerror(errno));
+  pid_t child = -1;
+  try {
+    child = SpawnImporter(path, fds[1]);
+  } catch (...) {
     close(fds[0]);
     close(fds[1]);
-    ThrowInputError(path, "mesh", "a process to read it in", std::strerror(errno));
-  }
-  if (child == 0) {
-    prctl(PR_SET_PDEATHSIG, SIGKILL);  // the importer dies with the process that waits for it
-    close(fds[0]);
-    ImportInChild(path, fds[1]);
+    throw;
   }
   close(fds[1]);
   std::string received;

@@ -18,8 +18,8 @@ struct MeshLoadOptions {
   /// When a referenced texture file is missing, use vertex or material colours (with a warning) instead of
   /// failing.
   bool allow_missing_textures = false;
-  /// The importer reads the file in a child process; one that takes longer than this (seconds) is ended and the
-  /// file refused (a malformed file can make it loop).
+  /// The importer reads the file in its own process (the program ecvpose-mesh-import); one that takes longer than
+  /// this (seconds) is ended and the file refused (a malformed file can make it loop).
   double import_timeout_s = 120.0;
 
   void Check() const;
@@ -29,12 +29,17 @@ struct MeshLoadOptions {
 double MetresPerUnit(const std::string& unit);
 
 /// Loads OBJ (+MTL and texture images), PLY (vertex colours), glTF/GLB and the other formats assimp
-/// reads. PLY files are checked first (CheckPlyFile), and assimp reads the file in a child process, so that a crash,
-/// an exception or a hang of it becomes an error naming the file. Throws InputError for a missing, malformed or
-/// unreadable file, a mesh without triangles or with non-finite vertices, or a missing texture or material library
-/// (unless allowed); `warnings` (may be null) receives what was tolerated.
+/// reads. PLY files are checked first (CheckPlyFile), and assimp reads the file in a process of its own (the program
+/// ecvpose-mesh-import, found beside the ecvpose libraries or at $ECVPOSE_MESH_IMPORTER), so that a crash, an
+/// exception or a hang of it becomes an error naming the file. Safe to call from several threads at once. Throws
+/// InputError for a missing, malformed or unreadable file, a mesh without triangles or with non-finite vertices, or a
+/// missing texture or material library (unless allowed); `warnings` (may be null) receives what was tolerated.
 TriangleMesh LoadMesh(const std::string& path, const MeshLoadOptions& options = {},
                       std::vector<std::string>* warnings = nullptr);
+
+/// The work of the program ecvpose-mesh-import: reads `path` with assimp and writes to `fd` the mesh, or the error's
+/// message, in the form LoadMesh reads back. Returns the program's exit code (0, or 3 when `fd` closed early).
+int RunMeshImporter(const std::string& path, int fd);
 
 /// Rigid transforms by name from a text table with lines "name r11 r12 r13 r21 r22 r23 r31 r32 r33 tx ty tz
 /// [anything]" ('#' starts a comment), such as YCB's derived/google16k_to_ycbv.txt (p_to = R p_from + t,

@@ -1,9 +1,13 @@
 // Malformed mesh files: each is refused with an InputError naming the file and what is wrong, never a crash of the
 // importer (PLY counts and indices checked before it reads them; the importer itself runs in a child process).
 
+#include <atomic>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
+#include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -136,6 +140,55 @@ TEST_F(MalformedMesh, AFileTheImporterCannotReadIsNamed) {
   const std::string path = Write("noise.obj", std::string("v 1 2\nf 7 8 9 10\n\x01\x02garbage", 24));
   const std::string message = Refusal(path);
   EXPECT_NE(message.find(path), std::string::npos) << message;
+}
+
+// Meshes read on two threads at once while a third allocates without pause, as the recognizer reads its models: each
+// read finishes with the whole mesh. (A child forked from such a process could hang on a lock another thread held;
+// the importer program is started afresh instead.)
+TEST(LoadMesh, ReadsOnSeveralThreadsWhileAnotherAllocates) {
+  const std::string path = std::string(ECV_SOURCE_DIR) + "/models/meshes/003_cracker_box/003_cracker_box.obj";
+  MeshLoadOptions options;
+  options.import_timeout_s = 60.0;
+  const size_t triangles = LoadMesh(path, options).NumTriangles();
+  ASSERT_GT(triangles, 1000U);
+  std::atomic<bool> done{false};
+  std::thread allocator([&] {
+    std::vector<std::vector<double>> held(64);
+    for (size_t n = 0; !done; ++n) held[n % held.size()] = std::vector<double>(n % 4096 + 1);
+  });
+  std::vector<size_t> read(6, 0);
+  std::vector<std::string> errors(read.size());
+  std::vector<std::thread> readers;
+  for (size_t t = 0; t < 2; ++t) {
+    readers.emplace_back([&, t] {
+      for (size_t i = t; i < read.size(); i += 2) {
+        try {
+          read[i] = LoadMesh(path, options).NumTriangles();
+        } catch (const std::exception& error) {
+          errors[i] = error.what();
+        }
+      }
+    });
+  }
+  for (std::thread& reader : readers) reader.join();
+  done = true;
+  allocator.join();
+  for (size_t i = 0; i < read.size(); ++i) EXPECT_EQ(read[i], triangles) << errors[i];
+}
+
+// Without its importer program ecvpose cannot read meshes; the message says where it looked and how to point it.
+TEST(LoadMesh, AMissingImporterProgramIsNamedWithHowToPointToIt) {
+  const std::string gone = "/nonexistent/ecvpose-mesh-import";
+  ASSERT_EQ(setenv("ECVPOSE_MESH_IMPORTER", gone.c_str(), 1), 0);
+  std::string message;
+  try {
+    LoadMesh(std::string(ECV_SOURCE_DIR) + "/models/meshes/003_cracker_box/003_cracker_box.obj");
+  } catch (const std::runtime_error& error) {
+    message = error.what();
+  }
+  unsetenv("ECVPOSE_MESH_IMPORTER");
+  EXPECT_NE(message.find(gone), std::string::npos) << message;
+  EXPECT_NE(message.find("ECVPOSE_MESH_IMPORTER"), std::string::npos) << message;
 }
 
 }  // namespace

@@ -55,15 +55,17 @@ void LinkModels(const fs::path& directory, const std::vector<std::string>& names
 }
 
 // Runs ecvpose with `arguments`, as an unprivileged user when we are root (so that file permissions hold).
-// A copy of the ecvpose binary and its own libraries in a folder every user can read: the unprivileged user may not
-// reach the build tree (a checkout under /root, or in a private folder). The shell command that runs the copy.
+// A copy of the ecvpose binary, its own libraries and the mesh importer program beside them in a folder every user can
+// read: the unprivileged user may not reach the build tree (a checkout under /root, or in a private folder). The shell
+// command that runs the copy.
 std::string CliCopyForEveryone() {
   static test::TemporaryDirectory folder;
   static const std::string command = [] {
     const fs::path bin = folder.path();
     const auto everyone = fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec |
                           fs::perms::others_read | fs::perms::others_exec;
-    fs::permissions(bin, everyone);
+    const fs::path lib = bin / "lib";
+    fs::create_directories(lib / "ecvpose");
     fs::copy_file(ECV_CLI_PATH, bin / "ecvpose", fs::copy_options::overwrite_existing);
     FILE* ldd = popen(("ldd " + std::string(ECV_CLI_PATH)).c_str(), "r");
     char line[4096];
@@ -72,12 +74,17 @@ std::string CliCopyForEveryone() {
       std::string name, arrow, path;
       words >> name >> arrow >> path;  // "libecv_core.so.0 => /path/libecv_core.so.0 (0x...)"
       if (name.rfind("libecv_", 0) == 0 && arrow == "=>") {
-        fs::copy_file(path, bin / name, fs::copy_options::overwrite_existing);
+        fs::copy_file(path, lib / name, fs::copy_options::overwrite_existing);
+        if (name.rfind("libecv_core", 0) == 0) {
+          const fs::path importer = fs::path(path).parent_path() / "ecvpose" / "ecvpose-mesh-import";
+          fs::copy_file(importer, lib / "ecvpose" / importer.filename(), fs::copy_options::overwrite_existing);
+        }
       }
     }
     if (ldd != nullptr) pclose(ldd);
-    for (const auto& entry : fs::directory_iterator(bin)) fs::permissions(entry.path(), everyone);
-    return "env LD_LIBRARY_PATH=" + bin.string() + " " + (bin / "ecvpose").string();
+    for (const auto& entry : fs::recursive_directory_iterator(bin)) fs::permissions(entry.path(), everyone);
+    fs::permissions(bin, everyone);
+    return "env LD_LIBRARY_PATH=" + lib.string() + " " + (bin / "ecvpose").string();
   }();
   return command;
 }

@@ -18,3 +18,18 @@ if(NOT output MATCHES "^1066.78 4")
   message(FATAL_ERROR "unexpected output of the consumer: ${output}")
 endif()
 message(STATUS "consumer printed: ${output}")
+
+# The installed mesh importer program starts from the prefix (its libraries found there), and the installed CLI reads
+# a mesh through it.
+file(GLOB_RECURSE importer "${work}/prefix/*/ecvpose/ecvpose-mesh-import")
+if(NOT importer)
+  message(FATAL_ERROR "the install has no ecvpose/ecvpose-mesh-import beside the libraries")
+endif()
+execute_process(COMMAND ${importer} RESULT_VARIABLE code OUTPUT_QUIET ERROR_VARIABLE usage)
+if(NOT code EQUAL 2 OR NOT usage MATCHES "^usage: ecvpose-mesh-import")
+  message(FATAL_ERROR "the installed ${importer} did not start (${code}): ${usage}")
+endif()
+run("${work}/prefix/bin/ecvpose" info "${SOURCE_DIR}/models/meshes/003_cracker_box/003_cracker_box.obj")
+if(NOT output MATCHES "triangles")
+  message(FATAL_ERROR "unexpected output of the installed ecvpose info: ${output}")
+endif()
