@@ -8,14 +8,18 @@
 //   scripts/build_ycbv_library /tmp/ycbv.sqlite --views 40 --distance 0.9
 //   scripts/build_lmo_library /tmp/lmo.sqlite --views 40 --distance 1.0
 //   recognize_bench --db /tmp/ycbv.sqlite [--lmo-db /tmp/lmo.sqlite] [--peers] [--track] [--search-every N]
-//                   [--threads N] [--bytes] [--preselect N] [--turned] [--python EXE] [--figure F.jpg]
+//                   [--confirm-every N...] [--track-score S] [--seeds S...]
+//                   [--threads N] [--bytes] [--preselect N] [--turned] [--casts] [--python EXE] [--figure F.jpg]
 //                   [--results bench/RESULTS.md] [--frames N]
 // --threads N (N > 1) adds a run of ours with N worker threads: the same detections (checked), its own times.
 // --bytes adds a run of ours matching with ByteNeighbours (recognize --matcher bytes; needs AVX-512 VNNI).
 // --preselect N adds a run of ours searching only the N models a quick look scores best (recognize --preselect N).
 // --turned adds a run of ours on the same frames turned 180 degrees (a camera held upside down; ground truth moved).
+// --casts adds runs of ours on the same frames under changed light (white balance, gamma; ColorCasts below).
 // --track adds a run with the previous frame's detections as priors; --search-every N (N > 1) one more where
-// only every N-th frame of a video searches the models that are not tracked (recognize --search-every).
+// only every N-th frame of a video searches the models that are not tracked (recognize --search-every);
+// --confirm-every N... adds tracking runs with each TrackingOptions::confirm_every for each of --seeds, and
+// --track-score S sets the follow score of every tracking run (recognize --track-score).
 // --figure F.jpg draws the detections of ours and each peer in frame 0001/000001 (the demo frame) side by side.
 // --object-pixels also runs the peers on depth cut to the ground-truth objects' own pixels; --peers-only,
 // --frame-step, --ppf-sampling, --ppf-scene-distance and --min-inlier-fraction are for tuning the peers.
@@ -83,6 +87,28 @@ std::vector<NamedFrame> TurnedFrames(const std::vector<NamedFrame>& frames) {
     turned.push_back(std::move(copy));
   }
   return turned;
+}
+
+// The light changes of --casts: white balance 15 % warmer and 15 % cooler, and gamma 0.8 and 1.25.
+std::vector<std::pair<std::string, ColorCast>> ColorCasts() {
+  ColorCast warm, cool, bright, dark;
+  warm.rgb_gain = Eigen::Vector3d(1.15, 1.0, 0.85);
+  cool.rgb_gain = Eigen::Vector3d(0.85, 1.0, 1.15);
+  bright.gamma = 0.8;
+  dark.gamma = 1.25;
+  return {{"warm (R x1.15, B x0.85)", warm},
+          {"cool (R x0.85, B x1.15)", cool},
+          {"gamma 0.8", bright},
+          {"gamma 1.25", dark}};
+}
+
+// The `frames` with their colours changed by `cast`.
+std::vector<NamedFrame> CastFrames(const std::vector<NamedFrame>& frames, const ColorCast& cast) {
+  std::vector<NamedFrame> changed;
+  for (const NamedFrame& named : frames) {
+    changed.push_back({named.name, {WithColorCast(named.frame.rgbd, cast), named.frame.ground_truth}});
+  }
+  return changed;
 }
 
 std::vector<NamedFrame> LmoFrames(const std::string& data) {
@@ -170,6 +196,19 @@ Run RunPeer(RecognitionPeer& peer, const std::vector<NamedFrame>& frames, const 
   return run;
 }
 
+// The false positives that were tracked detections: a mistake carried on from an earlier frame (one instance per
+// model, so a false positive's model names its detection).
+int FollowedFalsePositives(const Run& run) {
+  int followed = 0;
+  for (size_t i = 0; i < run.frames.size() && i < run.detections.size(); ++i) {
+    for (const std::string& model : run.frames[i].false_positive_models) {
+      followed += static_cast<int>(std::count_if(run.detections[i].begin(), run.detections[i].end(),
+                                                 [&](const Detection& d) { return d.model == model && d.tracked; }));
+    }
+  }
+  return followed;
+}
+
 // Per object: correct / present; then recall, false positives and the median time per frame.
 std::string RecallTable(const Runs& runs) {
   std::map<std::string, std::map<std::string, std::pair<int, int>>> counts;  // object -> run -> (correct, present)
@@ -229,6 +268,8 @@ std::string RecallTable(const Runs& runs) {
     out << ' ' << Fixed(static_cast<double>(false_positives[label]) / std::max<size_t>(run.frames.size(), 1), 2)
         << " |";
   }
+  out << "\n| false positives followed from an earlier frame |";
+  for (const auto& [label, run] : runs) out << ' ' << FollowedFalsePositives(run) << " |";
   for (const bool median : {true, false}) {
     out << (median ? "\n| median ms per frame |" : "\n| mean ms per frame |");
     for (const auto& [label, run] : runs) {
@@ -343,8 +384,11 @@ struct Methods {
   int preselect = 0;    ///< > 0: ours also searching only this many pre-selected models (recognize --preselect)
   int threads = 1;      ///< > 1: ours also with this many worker threads (the same detections, faster)
   bool turned = false;  ///< ours also on the frames turned 180 degrees (a camera held upside down)
+  bool casts = false;   ///< ours also on the frames under each ColorCasts() light (and each seed)
   std::vector<std::string> hypotheses;  ///< ours also with these hypothesis sources (recognize --hypotheses)
-  std::vector<uint64_t> seeds;          ///< ours and the hypothesis runs repeated with each of these RANSAC seeds
+  std::vector<uint64_t> seeds;          ///< ours, the hypothesis and the tracking runs repeated with these seeds
+  std::vector<int> confirm_every;       ///< tracking also with each of these TrackingOptions::confirm_every
+  double track_score = -1.0;            ///< >= 0: tracking's TrackingOptions::min_follow_score
 };
 
 // The `methods` on `frames` with the library at `db`.
@@ -371,6 +415,20 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
     }
     if (methods.turned)
       runs.emplace_back(kTurned, RunRecognizer(library, options, TurnedFrames(frames), models, "turned"));
+    if (methods.casts) {
+      for (const auto& [name, cast] : ColorCasts()) {
+        const std::vector<NamedFrame> cast_frames = CastFrames(frames, cast);
+        const std::string label = std::string(kOurs) + ", light " + name;
+        runs.emplace_back(label, RunRecognizer(library, options, cast_frames, models, label));
+        for (const uint64_t seed : methods.seeds) {
+          RecognizerOptions seeded = options;
+          seeded.ransac.seed = seed;
+          runs.emplace_back(
+              label + ", seed " + std::to_string(seed),
+              RunRecognizer(library, seeded, cast_frames, models, label + ", seed " + std::to_string(seed)));
+        }
+      }
+    }
     if (methods.threads > 1) {
       RecognizerOptions threaded = options;
       threaded.ransac.threads = methods.threads;
@@ -402,10 +460,26 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
       }
     }
     if (methods.track) {
-      runs.emplace_back(kTracking, RunRecognizer(library, options, frames, models, "track", true));
+      RecognizerOptions tracking = options;
+      if (methods.track_score >= 0.0) tracking.tracking.min_follow_score = methods.track_score;
+      runs.emplace_back(kTracking, RunRecognizer(library, tracking, frames, models, "track", true));
       if (methods.search_every > 1) {
         runs.emplace_back(TrackingEvery(methods.search_every),
-                          RunRecognizer(library, options, frames, models, "track every", true, methods.search_every));
+                          RunRecognizer(library, tracking, frames, models, "track every", true, methods.search_every));
+      }
+      std::vector<int> confirm_every = methods.confirm_every;
+      if (confirm_every.empty()) confirm_every.push_back(tracking.tracking.confirm_every);
+      std::vector<uint64_t> seeds = methods.seeds;
+      if (seeds.empty()) seeds.push_back(tracking.ransac.seed);
+      for (const int every : confirm_every) {
+        RecognizerOptions confirming = tracking;
+        confirming.tracking.confirm_every = every;
+        for (const uint64_t seed : seeds) {
+          confirming.ransac.seed = seed;
+          const std::string label =
+              std::string(kTracking) + ", confirm every " + std::to_string(every) + ", seed " + std::to_string(seed);
+          runs.emplace_back(label, RunRecognizer(library, confirming, frames, models, label, true));
+        }
       }
     }
     options.refine = false;
@@ -570,6 +644,10 @@ int main(int argc, char** argv) {
          },
          "Implies --track; N > 1 also runs ours searching untracked models only every N-th frame (default: 1)")
       ->check(AtLeastOne());
+  app.add_option("--confirm-every", methods.confirm_every,
+                 "With --track: tracking also with each of these confirm_every values (recognize --confirm-every), "
+                 "for each of --seeds");
+  app.add_option("--track-score", methods.track_score, "With --track: the follow score (recognize --track-score)");
   app.add_option("--threads", methods.threads, "N > 1 also runs ours with N worker threads (same detections checked)")
       ->check(AtLeastOne())
       ->capture_default_str();
@@ -590,6 +668,9 @@ int main(int argc, char** argv) {
   app.add_option("--seeds", methods.seeds,
                  "Also run ours (and each --hypotheses run) with these RANSAC seeds (the default run has seed 1)");
   app.add_flag("--turned", methods.turned, "Also run ours on the frames turned 180 degrees (ground truth moved)");
+  app.add_flag("--casts", methods.casts,
+               "Also run ours on the frames under changed light: white balance 15 % warmer and cooler, gamma 0.8 and "
+               "1.25 (with each of --seeds)");
   app.add_option("--python", methods.python, "Python interpreter with Open3D for the Open3D peer")
       ->capture_default_str();
   app.add_option("--figure", figure,

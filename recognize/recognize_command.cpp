@@ -290,8 +290,15 @@ void AddTrackingFlags(CLI::App& command, RecognizeArgs* args) {
                   "searched for at once")
       ->capture_default_str();
   command
-      .add_option("--track-start-score", args->options.tracking.min_start_score,
-                  "With --track: a new detection is followed into the next frame only from this score on")
+      .add_option("--track-score", args->options.tracking.min_follow_score,
+                  "With --track: a detection is followed into the next frame only while it scores at least this,\n"
+                  "a first detection and a followed one alike")
+      ->capture_default_str();
+  command.add_option("--track-start-score", args->options.tracking.min_follow_score)->group("");  // its old name
+  command
+      .add_option("--confirm-every", args->options.tracking.confirm_every,
+                  "With --track: an object followed this many frames since a search last found it has its model\n"
+                  "searched again; the better of the two poses is kept (0: never)")
       ->capture_default_str();
 }
 

@@ -30,8 +30,10 @@ struct ModelInFrame {
   std::vector<const Detection*> priors;
   std::vector<Verified> instances;
   cv::Mat covered;
-  bool lost = false;  // seen before: a prior failed or was a first detection too weak to follow
+  bool lost = false;  // seen before: a prior failed or scored too low to follow
   bool search = false;
+  // Tracked instances due for confirmation, set aside while their model is searched as if it had no priors.
+  std::vector<Verified> to_confirm;
 };
 
 // What searching a model found besides its instances.
@@ -144,6 +146,7 @@ class Recognizer::Impl {
     if (options_.point_pairs.source != HypothesisSource::kContext) SearchByPointPairs(scene, &models, &times);
     std::vector<Verified> candidates;
     for (size_t m = 0; m < models.size(); ++m) {
+      MergeConfirmation(frame.depth.size(), &models[m]);
       times += searches[m].times;
       if (searches[m].views_tried >= 0) result.views_tried[records_[m].name] = searches[m].views_tried;
       for (Verified& verified : models[m].instances) candidates.push_back(std::move(verified));
@@ -194,14 +197,14 @@ class Recognizer::Impl {
     model->instances.push_back(std::move(verified));
   }
 
-  // Each model's priors to follow, in their order. A first detection below tracking.min_start_score is not followed
-  // but makes its model `lost`: it was seen, so even a frame that searches only for lost tracks searches for it.
+  // Each model's priors to follow, in their order. A prior below tracking.min_follow_score is not followed but makes
+  // its model `lost`: it was seen, so even a frame that searches only for lost tracks searches for it.
   std::vector<ModelInFrame> AssignPriors(const std::vector<Detection>& priors) const {
     std::vector<ModelInFrame> models(records_.size());
     for (const Detection& prior : priors) {
       const std::optional<size_t> m = ModelIndex(prior.model);
       if (!m) continue;
-      if (prior.tracked || prior.score >= options_.tracking.min_start_score) {
+      if (prior.score >= options_.tracking.min_follow_score) {
         models[*m].priors.push_back(&prior);
       } else {
         models[*m].lost = true;
@@ -227,16 +230,65 @@ class Recognizer::Impl {
     });
   }
 
-  // Marks the models to search in this frame (all instances not yet found; under kLostTracks only lost ones); their
-  // count.
+  // Marks the models to search in this frame: those with instances not yet found (under kLostTracks only lost ones),
+  // and those with a track due for confirmation, whose tracked instances are set aside meanwhile. Their count.
   int ChooseModels(SearchScope scope, std::vector<ModelInFrame>* models) const {
+    const int confirm_every = options_.tracking.confirm_every;
     int count = 0;
     for (ModelInFrame& model : *models) {
-      model.search = static_cast<int>(model.instances.size()) < options_.max_instances &&
-                     (scope == SearchScope::kAllModels || model.lost);
+      const bool due = confirm_every > 0 &&
+                       std::any_of(model.instances.begin(), model.instances.end(), [&](const Verified& instance) {
+                         return instance.detection.frames_followed >= confirm_every;
+                       });
+      if (due) {
+        model.to_confirm = std::move(model.instances);
+        model.instances.clear();
+        model.covered = cv::Mat();
+      }
+      model.search = due || (static_cast<int>(model.instances.size()) < options_.max_instances &&
+                             (scope == SearchScope::kAllModels || model.lost));
       count += model.search ? 1 : 0;
     }
     return count;
+  }
+
+  // A confirming search's instances and the tracked ones it set aside compete on score: best first, each kept unless
+  // it lies mostly (max_overlap) on a kept one's surface, up to max_instances. A kept track that a searched instance
+  // lay on is confirmed (its count starts again); a track the search did not find keeps counting, so its model is
+  // searched again in the next frame.
+  void MergeConfirmation(const cv::Size& image_size, ModelInFrame* model) const {
+    if (model->to_confirm.empty()) return;
+    std::vector<Verified> candidates = std::move(model->to_confirm);
+    model->to_confirm.clear();
+    for (Verified& searched : model->instances) candidates.push_back(std::move(searched));
+    std::stable_sort(candidates.begin(), candidates.end(),
+                     [](const Verified& a, const Verified& b) { return a.detection.score > b.detection.score; });
+    model->instances.clear();
+    model->covered = cv::Mat();
+    for (Verified& candidate : candidates) {
+      Verified* same_surface = nullptr;
+      for (Verified& kept : model->instances) {
+        if (SharedFraction(candidate.surface, kept.surface, image_size) > options_.max_overlap) same_surface = &kept;
+      }
+      if (same_surface != nullptr) {
+        if (same_surface->detection.tracked != candidate.detection.tracked) same_surface->detection.frames_followed = 0;
+        continue;
+      }
+      if (static_cast<int>(model->instances.size()) < options_.max_instances) {
+        AddInstance(std::move(candidate), options_.dense_stride_px, image_size, model);
+      }
+    }
+  }
+
+  // The share of `surface`'s pixels that `other` covers too.
+  static double SharedFraction(const std::vector<cv::Point>& surface, const std::vector<cv::Point>& other,
+                               const cv::Size& image_size) {
+    if (surface.empty()) return 0.0;
+    cv::Mat mask = cv::Mat::zeros(image_size, CV_8UC1);
+    for (const cv::Point& p : other) mask.at<uchar>(p) = 1;
+    const auto shared =
+        std::count_if(surface.begin(), surface.end(), [&](const cv::Point& p) { return mask.at<uchar>(p) != 0; });
+    return static_cast<double>(shared) / static_cast<double>(surface.size());
   }
 
   // Keeps searching only the preselect.models models with the best quick scores (ModelSearch::QuickScore); ties go to
@@ -292,6 +344,7 @@ class Recognizer::Impl {
       if (refined.detection.score >= best.detection.score) best = std::move(refined);
     }
     best.detection.tracked = true;
+    best.detection.frames_followed = prior.frames_followed + 1;
     best.detection.hypothesis = prior.hypothesis;
     return best;
   }

@@ -37,6 +37,9 @@ struct Detection {
   double edge_agreement = 0.0;
   int edge_pixels = 0;   ///< ... and how many were predicted
   bool tracked = false;  ///< found from a prior (the previous frame's pose), without RANSAC
+  /// Frames it has been followed since a search of its model last found it (0: a search found it in this frame);
+  /// TrackingOptions::confirm_every.
+  int frames_followed = 0;
   /// Where its pose came from: kContext (view ranking and RANSAC) or kPpf (point pair features); a tracked
   /// detection keeps its first detection's.
   HypothesisSource hypothesis = HypothesisSource::kContext;
@@ -81,8 +84,9 @@ Descriptors ComputeSceneDescriptors(const std::vector<Primitive>& primitives, co
 /// following its priors.
 enum class SearchScope {
   kAllModels,  ///< every model whose prior fails or that has none: a full detection frame
-  /// Only the models whose prior failed or fell below TrackingOptions::min_start_score (a lost track is looked for at
-  /// once); models without a prior are not looked for. When every prior passes, the frame's primitives are not even
+  /// Only the models whose prior failed or fell below TrackingOptions::min_follow_score (a lost track is looked for at
+  /// once) or whose track is due for confirmation (TrackingOptions::confirm_every); models without a prior are not
+  /// looked for. When every prior passes and none is due, the frame's primitives are not even
   /// extracted. RecognitionStream alternates it with full frames to follow known objects at a fraction of the cost
   /// and still pick up new ones every N frames.
   kLostTracks,
@@ -99,9 +103,10 @@ class Recognizer {
 
   RecognitionResult Recognize(const RgbdFrame& frame);
 
-  /// Tracking, for frames of a stream (beyond the paper): each prior (a detection of the previous frame) is
-  /// first tried at its pose, refined by ICP and verified as any detection; when it passes, its model skips
-  /// view ranking and RANSAC in this frame. Which of the other models are searched: see SearchScope.
+  /// Tracking, for frames of a stream (beyond the paper): each prior (a detection of the previous frame) that scored
+  /// at least tracking.min_follow_score is first tried at its pose, refined by ICP and verified as any detection;
+  /// when it passes, its model skips view ranking and RANSAC in this frame, unless the track is due for confirmation
+  /// (tracking.confirm_every). Which of the other models are searched: see SearchScope.
   RecognitionResult Recognize(const RgbdFrame& frame, const std::vector<Detection>& priors,
                               SearchScope scope = SearchScope::kAllModels);
 

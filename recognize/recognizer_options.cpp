@@ -66,7 +66,9 @@ void RecognizerOptions::Check() const {
   require(preselect.models >= 0, "preselect.models", ">= 0 (0: search every model)");
   require(preselect.view_stride >= 1, "preselect.view_stride", "at least 1");
   require(preselect.rows >= 3, "preselect.rows", "at least 3");
-  require(tracking.min_start_score >= 0.0 && tracking.min_start_score <= 1.0, "tracking.min_start_score", "in [0, 1]");
+  require(tracking.min_follow_score >= 0.0 && tracking.min_follow_score <= 1.0, "tracking.min_follow_score",
+          "in [0, 1]");
+  require(tracking.confirm_every >= 0, "tracking.confirm_every", ">= 0 (0: never)");
   require(views_per_model >= 1, "views_per_model", "at least 1");
   require(good_enough_score >= 0.0, "good_enough_score", ">= 0 (0: try every ranked view)");
   require(give_up_after_views >= 0, "give_up_after_views", ">= 0 (0: never give up)");

@@ -30,10 +30,15 @@ struct PreselectOptions {
 
 /// Tracking between the frames of a stream (Recognizer::Recognize with priors).
 struct TrackingOptions {
-  /// A prior that was not itself tracked (a first detection) is followed only from this score on; once followed,
-  /// it is kept while it verifies (VerifyOptions::min_score). A false detection near min_score then shows in one
-  /// frame instead of persisting along the stream.
-  double min_start_score = 0.35;
+  /// A detection is followed into the next frame only while it scores at least this, whether a search found it or
+  /// it was followed itself: a track keeps earning the bar it started from. Below it (down to VerifyOptions::min_score)
+  /// a detection is reported, and its model searched for afresh in the next frame. The default is verification's
+  /// own bar: what is reported is followed, and a wrong track loses to a better-supported detection on its surface.
+  double min_follow_score = 0.3;
+  /// A followed object's model is searched for again (view ranking and RANSAC, as without priors) once it has been
+  /// followed this many frames since a search last found it. The search's and the track's poses then compete on
+  /// score: one on the same surface confirms the track, a better one elsewhere replaces it. 0: never.
+  int confirm_every = 5;
 };
 
 /// Where pose hypotheses come from: the shape and appearance context descriptors (view ranking and RANSAC), point

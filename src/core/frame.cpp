@@ -72,6 +72,25 @@ RgbdFrame TurnUpsideDown(const RgbdFrame& frame) {
   return turned;
 }
 
+RgbdFrame WithColorCast(const RgbdFrame& frame, const ColorCast& cast) {
+  if (!(cast.gamma > 0.0) || !(cast.rgb_gain.minCoeff() >= 0.0) || !cast.rgb_gain.allFinite()) {
+    ThrowInputError("colour cast", "gains and gamma", "finite gains >= 0 and a gamma > 0");
+  }
+  // One table per channel: 256 values in, 256 out.
+  cv::Mat table(1, 256, CV_8UC3);
+  for (int value = 0; value < 256; ++value) {
+    for (int channel = 0; channel < 3; ++channel) {
+      const double scaled = std::min(1.0, cast.rgb_gain[channel] * value / 255.0);
+      table.at<cv::Vec3b>(0, value)[channel] = cv::saturate_cast<uchar>(255.0 * std::pow(scaled, cast.gamma));
+    }
+  }
+  RgbdFrame cast_frame = frame;
+  cast_frame.color = cv::Mat();  // a new image, not the caller's
+  cv::LUT(frame.color, table, cast_frame.color);
+  cast_frame.depth = frame.depth.clone();
+  return cast_frame;
+}
+
 Eigen::Isometry3d TurnedFromCamera() {
   Eigen::Isometry3d turned = Eigen::Isometry3d::Identity();
   turned.linear() = Eigen::Vector3d(-1.0, -1.0, 1.0).asDiagonal();

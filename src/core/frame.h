@@ -40,6 +40,16 @@ DepthStats ComputeDepthStats(const cv::Mat& depth, const cv::Mat& mask = cv::Mat
 /// recognition depends on how the camera is held (recognize_bench --turned).
 RgbdFrame TurnUpsideDown(const RgbdFrame& frame);
 
+/// A change of the light's colour and of the camera's response: each channel scaled by its gain, then the 0..1
+/// intensities raised to `gamma`. Used to measure how recognition depends on the light (recognize_bench --casts).
+struct ColorCast {
+  Eigen::Vector3d rgb_gain = Eigen::Vector3d::Ones();
+  double gamma = 1.0;
+};
+
+/// The frame as a camera under the cast light sees it: colours changed by `cast` (clipped to 0..255), depth the same.
+RgbdFrame WithColorCast(const RgbdFrame& frame, const ColorCast& cast);
+
 /// diag(-1, -1, 1): the turned camera of TurnUpsideDown from the original one (its own inverse).
 Eigen::Isometry3d TurnedFromCamera();
 

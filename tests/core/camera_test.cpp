@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -132,6 +133,33 @@ TEST(TurnUpsideDown, SeesEveryPointWhereTheRolledCameraSeesIt) {
   EXPECT_DOUBLE_EQ(back.camera.cx, frame.camera.cx);
   EXPECT_DOUBLE_EQ(back.camera.cy, frame.camera.cy);
   EXPECT_TRUE((TurnedFromCamera() * TurnedFromCamera()).isApprox(Eigen::Isometry3d::Identity()));
+}
+
+// A colour cast scales each channel by its gain and then applies the gamma to 0..1 intensities, clipped; depth and
+// the caller's image stay as they were; a negative gain or a gamma of 0 is refused.
+TEST(WithColorCast, ScalesEachChannelThenAppliesTheGammaAndLeavesTheOriginal) {
+  const RgbdFrame frame = GradientFrame();
+  const cv::Mat original = frame.color.clone();
+  ColorCast cast;
+  cast.rgb_gain = Eigen::Vector3d(1.15, 1.0, 0.5);
+  cast.gamma = 2.0;
+  const RgbdFrame changed = WithColorCast(frame, cast);
+  changed.Check();
+  for (const cv::Point pixel : {cv::Point(0, 0), cv::Point(639, 479), cv::Point(100, 300), cv::Point(313, 241)}) {
+    const cv::Vec3b in = frame.color.at<cv::Vec3b>(pixel), out = changed.color.at<cv::Vec3b>(pixel);
+    for (int channel = 0; channel < 3; ++channel) {
+      const double expected = 255.0 * std::pow(std::min(1.0, cast.rgb_gain[channel] * in[channel] / 255.0), 2.0);
+      EXPECT_NEAR(out[channel], expected, 0.5) << pixel << " channel " << channel;
+    }
+  }
+  EXPECT_EQ(cv::norm(frame.color, original, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(changed.depth, frame.depth, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(WithColorCast(frame, ColorCast()).color, frame.color, cv::NORM_INF), 0.0);
+  cast.gamma = 0.0;
+  EXPECT_THROW(WithColorCast(frame, cast), InputError);
+  cast.gamma = 1.0;
+  cast.rgb_gain.z() = -1.0;
+  EXPECT_THROW(WithColorCast(frame, cast), InputError);
 }
 
 }  // namespace

@@ -314,23 +314,92 @@ TEST_F(RecognizeEndToEnd, WhenEveryModelIsTrackedNoPrimitivesAreExtracted) {
   }
 }
 
-TEST_F(RecognizeEndToEnd, AFirstDetectionBelowTheTrackStartScoreIsNotFollowed) {
+// One bar for following: a prior below tracking.min_follow_score is not followed, whether it was a first detection or
+// a track already followed; its model is searched for afresh.
+TEST_F(RecognizeEndToEnd, APriorBelowTheFollowScoreIsNotFollowedFirstDetectionOrTrackAlike) {
   const ModelLibrary library = Library({"003_cracker_box"});
   const LoadedFrame frame = LoadYcbvFrame(Frame());
   RecognizerOptions options;
   std::vector<Detection> priors = Recognizer(library, options).Recognize(frame.rgbd).detections;
   ASSERT_EQ(priors.size(), 1U);
-  options.tracking.min_start_score = std::min(1.0, priors[0].score + 0.01);
+  options.tracking.min_follow_score = std::min(1.0, priors[0].score + 0.01);
+  Recognizer strict(library, options);
+  for (const bool tracked : {false, true}) {
+    priors[0].tracked = tracked;
+    const RecognitionResult result = strict.Recognize(frame.rgbd, priors);
+    ASSERT_EQ(result.detections.size(), 1U);
+    EXPECT_FALSE(result.detections[0].tracked);
+    EXPECT_GT(result.scene_primitives, 0);
+  }
+  options.tracking.min_follow_score = priors[0].score;
+  const RecognitionResult followed = Recognizer(library, options).Recognize(frame.rgbd, priors);
+  ASSERT_EQ(followed.detections.size(), 1U);
+  EXPECT_TRUE(followed.detections[0].tracked);
+  EXPECT_EQ(followed.detections[0].frames_followed, 1);
+  EXPECT_EQ(followed.scene_primitives, 0);
+}
+
+// A track followed confirm_every frames since a search last found it has its model searched again: the search finds
+// the bottle on the track's surface, which confirms the track (its count starts again); a track not yet due is
+// followed without a search.
+TEST_F(RecognizeEndToEnd, ATrackDueForConfirmationIsSearchedAndConfirmedOnItsSurface) {
+  const ModelLibrary library = Library({"006_mustard_bottle"});
+  const LoadedFrame frame = LoadYcbvFrame(Frame());
+  Recognizer recognizer(library);
+  std::vector<Detection> priors = recognizer.Recognize(frame.rgbd).detections;
+  ASSERT_EQ(priors.size(), 1U);
+  priors[0].tracked = true;
+  const int confirm_every = RecognizerOptions().tracking.confirm_every;
+  ASSERT_GT(confirm_every, 1);
+
+  priors[0].frames_followed = confirm_every - 2;
+  const RecognitionResult not_due = recognizer.Recognize(frame.rgbd, priors);
+  ASSERT_EQ(not_due.detections.size(), 1U);
+  EXPECT_TRUE(not_due.detections[0].tracked);
+  EXPECT_EQ(not_due.detections[0].frames_followed, confirm_every - 1);
+  EXPECT_EQ(not_due.views_tried.count("006_mustard_bottle"), 0U);
+
+  priors[0].frames_followed = confirm_every - 1;
+  const RecognitionResult due = recognizer.Recognize(frame.rgbd, priors, SearchScope::kLostTracks);
+  ASSERT_EQ(due.detections.size(), 1U);
+  EXPECT_EQ(due.views_tried.count("006_mustard_bottle"), 1U);
+  EXPECT_EQ(due.detections[0].frames_followed, 0);
+  const GroundTruth* truth = TruthOf(frame, "006_mustard_bottle");
+  ASSERT_NE(truth, nullptr);
+  EXPECT_LT(TranslationDistance(due.detections[0].camera_from_object, truth->camera_from_object), 0.01);
+}
+
+// A track that still verifies at a wrong place (here 20 cm beside the cracker box, with every pose reported) is
+// replaced when its confirming search finds the box where it is, with a higher score; until then it is followed.
+TEST_F(RecognizeEndToEnd, ATrackTheConfirmingSearchDisagreesWithIsReplaced) {
+  const ModelLibrary library = Library({"003_cracker_box"});
+  const LoadedFrame frame = LoadYcbvFrame(Frame());
+  RecognizerOptions options;
+  options.verify.min_score = 0.0;
+  options.verify.min_visible_fraction = 0.0;
+  options.refine = false;  // the wrong prior stays where it is put
   Recognizer recognizer(library, options);
-  const RecognitionResult fresh = recognizer.Recognize(frame.rgbd, priors);  // a first appearance, below the bar
-  ASSERT_EQ(fresh.detections.size(), 1U);
-  EXPECT_FALSE(fresh.detections[0].tracked);
-  EXPECT_GT(fresh.scene_primitives, 0);
-  priors[0].tracked = true;  // a track already followed is kept while it scores min_score
-  const RecognitionResult kept = recognizer.Recognize(frame.rgbd, priors);
-  ASSERT_EQ(kept.detections.size(), 1U);
-  EXPECT_TRUE(kept.detections[0].tracked);
-  EXPECT_EQ(kept.scene_primitives, 0);
+  const GroundTruth* truth = TruthOf(frame, "003_cracker_box");
+  ASSERT_NE(truth, nullptr);
+  std::vector<Detection> priors(1);
+  priors[0].model = "003_cracker_box";
+  priors[0].score = 1.0;
+  priors[0].tracked = true;
+  priors[0].camera_from_object = truth->camera_from_object;
+  priors[0].camera_from_object.translation().x() += 0.2;
+
+  const RecognitionResult followed = recognizer.Recognize(frame.rgbd, priors);
+  ASSERT_EQ(followed.detections.size(), 1U);
+  EXPECT_TRUE(followed.detections[0].tracked);
+  EXPECT_GT(TranslationDistance(followed.detections[0].camera_from_object, truth->camera_from_object), 0.15);
+
+  priors[0].frames_followed = options.tracking.confirm_every - 1;
+  const RecognitionResult replaced = recognizer.Recognize(frame.rgbd, priors);
+  ASSERT_EQ(replaced.detections.size(), 1U);
+  EXPECT_FALSE(replaced.detections[0].tracked);
+  EXPECT_EQ(replaced.detections[0].frames_followed, 0);
+  EXPECT_GT(replaced.detections[0].score, followed.detections[0].score);
+  EXPECT_LT(TranslationDistance(replaced.detections[0].camera_from_object, truth->camera_from_object), 0.01);
 }
 
 // A tracking frame that searches only for lost tracks (SearchScope::kLostTracks, `recognize --search-every`):
