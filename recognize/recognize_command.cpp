@@ -293,13 +293,17 @@ void AddTrackingFlags(CLI::App& command, RecognizeArgs* args) {
       .add_option("--track-score", args->options.tracking.min_follow_score,
                   "With --track: a detection is followed into the next frame only while it scores at least this,\n"
                   "a first detection and a followed one alike")
-      ->capture_default_str();
-  command.add_option("--track-start-score", args->options.tracking.min_follow_score)->group("");  // its old name
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
+  command.add_option("--track-start-score", args->options.tracking.min_follow_score)
+      ->group("")  // its old name
+      ->check(CLI::Range(0.0, 1.0));
   command
       .add_option("--confirm-every", args->options.tracking.confirm_every,
                   "With --track: an object followed this many frames since a search last found it has its model\n"
                   "searched again; the better of the two poses is kept (0: never)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
 }
 
 // The flags of verification, RANSAC's inliers, matching and ICP.

@@ -529,6 +529,13 @@ TEST_F(RecognizeEndToEnd, BadInputIsReported) {
       test::RunCli("recognize --db " + library_ + " --hypotheses shape " + Frame());
   EXPECT_EQ(unknown_source.exit_code, 2) << unknown_source.output;
   EXPECT_NE(unknown_source.output.find("--hypotheses"), std::string::npos) << unknown_source.output;
+  for (const char* flags : {"--track-score 1.5", "--confirm-every -1"}) {
+    const test::CommandResult out_of_range =
+        test::RunCli("recognize --db " + library_ + " --track " + flags + " " + Frame());
+    EXPECT_EQ(out_of_range.exit_code, 2) << out_of_range.output;
+    EXPECT_NE(out_of_range.output.find(std::string(flags).substr(0, std::string(flags).find(' '))), std::string::npos)
+        << out_of_range.output;
+  }
 }
 
 // The library holds the meshes verification renders: a copy whose mesh paths lead nowhere recognises as the
@@ -612,6 +619,12 @@ TEST(RecognizerOptions, OutOfRangeValuesAreReportedByName) {
   options = RecognizerOptions();
   options.max_instances = 0;
   EXPECT_NE(message(options).find("max_instances"), std::string::npos) << message(options);
+  options = RecognizerOptions();
+  options.tracking.min_follow_score = -0.1;
+  EXPECT_NE(message(options).find("tracking.min_follow_score"), std::string::npos) << message(options);
+  options = RecognizerOptions();
+  options.tracking.confirm_every = -1;
+  EXPECT_NE(message(options).find("tracking.confirm_every"), std::string::npos) << message(options);
   options = RecognizerOptions();
   options.later_instance_views = -1;
   EXPECT_NE(message(options).find("later_instance_views"), std::string::npos) << message(options);
