@@ -405,28 +405,23 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
          << ". ";
   Runs runs;
   RecognizerOptions options;
-  if (methods.ours) {
-    runs.emplace_back(kOurs, RunRecognizer(library, options, frames, models, "icp"));
+  // A run of `settings` on `run_frames` labelled `label`, then one more per --seeds seed, labelled ", seed N".
+  const auto add_seeded = [&](const std::string& label, RecognizerOptions settings,
+                              const std::vector<NamedFrame>& run_frames) {
+    runs.emplace_back(label, RunRecognizer(library, settings, run_frames, models, label));
     for (const uint64_t seed : methods.seeds) {
-      RecognizerOptions seeded = options;
-      seeded.ransac.seed = seed;
-      runs.emplace_back(std::string(kOurs) + ", seed " + std::to_string(seed),
-                        RunRecognizer(library, seeded, frames, models, "seed " + std::to_string(seed)));
+      settings.ransac.seed = seed;
+      const std::string seeded = label + ", seed " + std::to_string(seed);
+      runs.emplace_back(seeded, RunRecognizer(library, settings, run_frames, models, seeded));
     }
+  };
+  if (methods.ours) {
+    add_seeded(kOurs, options, frames);
     if (methods.turned)
       runs.emplace_back(kTurned, RunRecognizer(library, options, TurnedFrames(frames), models, "turned"));
     if (methods.casts) {
       for (const auto& [name, cast] : ColorCasts()) {
-        const std::vector<NamedFrame> cast_frames = CastFrames(frames, cast);
-        const std::string label = std::string(kOurs) + ", light " + name;
-        runs.emplace_back(label, RunRecognizer(library, options, cast_frames, models, label));
-        for (const uint64_t seed : methods.seeds) {
-          RecognizerOptions seeded = options;
-          seeded.ransac.seed = seed;
-          runs.emplace_back(
-              label + ", seed " + std::to_string(seed),
-              RunRecognizer(library, seeded, cast_frames, models, label + ", seed " + std::to_string(seed)));
-        }
+        add_seeded(std::string(kOurs) + ", light " + name, options, CastFrames(frames, cast));
       }
     }
     if (methods.threads > 1) {
@@ -451,13 +446,7 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
     for (const std::string& source : methods.hypotheses) {
       RecognizerOptions sourced = options;
       sourced.point_pairs.source = ParseHypothesisSource(source, "--hypotheses");
-      const std::string label = std::string(kOurs) + ", --hypotheses " + source;
-      runs.emplace_back(label, RunRecognizer(library, sourced, frames, models, "hypotheses " + source));
-      for (const uint64_t seed : methods.seeds) {
-        sourced.ransac.seed = seed;
-        runs.emplace_back(label + ", seed " + std::to_string(seed),
-                          RunRecognizer(library, sourced, frames, models, label + ", seed " + std::to_string(seed)));
-      }
+      add_seeded(std::string(kOurs) + ", --hypotheses " + source, sourced, frames);
     }
     if (methods.track) {
       RecognizerOptions tracking = options;
