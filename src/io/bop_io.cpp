@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "io/frame_io.h"
+#include "io/paths.h"
 #include "io/pose_io.h"
 
 namespace ecv {
@@ -59,13 +60,13 @@ cv::Rect Box(const nlohmann::json& entry, const char* key, const std::string& pa
 
 std::vector<GroundTruth> ReadBopGroundTruth(const std::string& scene_dir, int image_id) {
   const std::string gt_path = (fs::path(scene_dir) / "scene_gt.json").string();
-  if (!fs::exists(gt_path)) return {};
+  if (!PathExists(gt_path)) return {};
   const nlohmann::json gt_file = ReadJsonFile(gt_path);
   const nlohmann::json& objects = ImageEntry(gt_file, gt_path, image_id);
   if (!objects.is_array()) ThrowInputError(gt_path, std::to_string(image_id), "an array of objects");
   const std::string info_path = (fs::path(scene_dir) / "scene_gt_info.json").string();
   const nlohmann::json info =
-      fs::exists(info_path) ? ImageEntry(ReadJsonFile(info_path), info_path, image_id) : nlohmann::json::array();
+      PathExists(info_path) ? ImageEntry(ReadJsonFile(info_path), info_path, image_id) : nlohmann::json::array();
   if (!info.empty() && info.size() != objects.size()) {
     ThrowInputError(info_path, std::to_string(image_id), std::to_string(objects.size()) + " entries as scene_gt.json");
   }
@@ -110,9 +111,9 @@ LoadedFrame LoadBopFrame(const std::string& scene_dir, int image_id, const std::
   std::string color_path = ImageFile(scene_dir, "rgb", image_id, ".png");
   for (const auto& [folder, extension] :
        {std::pair{"rgb", ".jpg"}, std::pair{"gray", ".png"}, std::pair{"gray", ".tif"}}) {
-    if (!fs::exists(color_path)) color_path = ImageFile(scene_dir, folder, image_id, extension);
+    if (!PathExists(color_path)) color_path = ImageFile(scene_dir, folder, image_id, extension);
   }
-  if (!fs::exists(color_path)) color_path = ImageFile(scene_dir, "rgb", image_id, ".png");  // name it in the error
+  if (!PathExists(color_path)) color_path = ImageFile(scene_dir, "rgb", image_id, ".png");  // name it in the error
   const std::string depth_path =
       depth_override.empty() ? ImageFile(scene_dir, "depth", image_id, ".png") : depth_override;
 

@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
+#include "io/paths.h"
 #include "io/pose_io.h"
 
 namespace ecv {
@@ -22,8 +23,8 @@ constexpr const char* kFrameForms =
     "SCENE_DIR:IMAGE_ID or an organized .pcd";
 
 void RequireFile(const std::string& path, const std::string& what) {
-  if (!fs::exists(path)) ThrowInputError(path, what, "an existing file", "no such file");
-  if (fs::is_directory(path)) ThrowInputError(path, what, "a file", "a directory");
+  if (!PathExists(path)) ThrowInputError(path, what, "an existing file", "no such file");
+  if (IsDirectory(path)) ThrowInputError(path, what, "a file", "a directory");
 }
 
 std::string ImageTypeText(const cv::Mat& image) {
@@ -44,7 +45,7 @@ bool SplitBopImage(const std::string& text, std::string* scene_dir, int* image_i
   if (id.find_first_not_of("0123456789") != std::string::npos || id.size() > 9) return false;
   *scene_dir = text.substr(0, colon);
   *image_id = std::stoi(id);
-  return fs::is_directory(*scene_dir);
+  return IsDirectory(*scene_dir);
 }
 
 bool HasFlagForm(const FrameSpec& spec) {
@@ -72,8 +73,8 @@ LoadedFrame LoadPositional(const FrameSpec& spec) {
   }
   if (EndsWith(path, ".json")) return LoadFrameJson(path);
   if (EndsWith(path, ".pcd")) return LoadPcdFrame(path);
-  if (fs::exists(path + "-color.png")) return LoadYcbvFrame(path);
-  if (fs::exists(path)) ThrowInputError(path, "FRAME", kFrameForms, "a file of none of these forms");
+  if (PathExists(path + "-color.png")) return LoadYcbvFrame(path);
+  if (PathExists(path)) ThrowInputError(path, "FRAME", kFrameForms, "a file of none of these forms");
   ThrowInputError(path, "FRAME", kFrameForms, "no such file, YCB-Video prefix or BOP scene directory");
 }
 
@@ -91,7 +92,7 @@ std::vector<std::string> ListBopSceneFrames(const fs::path& scene_dir) {
     ids.push_back(std::stoi(key));
   }
   std::sort(ids.begin(), ids.end());
-  if (!fs::is_directory(scene_dir / "depth")) {
+  if (!IsDirectory(scene_dir / "depth")) {
     ThrowInputError((scene_dir / "depth").string(), "depth",
                     "a depth/ folder with the depth PNGs of the images of scene_camera.json",
                     "no such folder (a single image can be given as SCENE_DIR:ID with --depth)");
@@ -104,9 +105,9 @@ std::vector<std::string> ListBopSceneFrames(const fs::path& scene_dir) {
     bool has_color = false;
     for (const auto& [folder, extension] :
          {std::pair{"rgb", ".png"}, std::pair{"rgb", ".jpg"}, std::pair{"gray", ".png"}, std::pair{"gray", ".tif"}}) {
-      has_color = has_color || fs::exists(scene_dir / folder / (stem + extension));
+      has_color = has_color || PathExists(scene_dir / folder / (stem + extension));
     }
-    if (has_color && fs::exists(scene_dir / "depth" / (stem + ".png"))) {
+    if (has_color && PathExists(scene_dir / "depth" / (stem + ".png"))) {
       frames.push_back(scene_dir.string() + ":" + std::to_string(id));
     }
   }
@@ -122,7 +123,10 @@ std::vector<std::string> ListBopSceneFrames(const fs::path& scene_dir) {
 // YCB-Video prefixes (*-color.png) and frame JSONs of a directory, in name order.
 std::vector<std::string> ListDirectoryFrames(const fs::path& directory) {
   std::vector<std::string> frames;
-  for (const auto& entry : fs::directory_iterator(directory)) {
+  std::error_code error;
+  fs::directory_iterator entries(directory, error);
+  if (error) ThrowInputError(directory.string(), "sequence", "a folder this user can list", error.message());
+  for (const auto& entry : entries) {
     const std::string name = entry.path().string();
     const std::string suffix = "-color.png";
     if (EndsWith(name, suffix)) {
@@ -152,18 +156,18 @@ std::vector<std::string> ListFileFrames(const std::string& path) {
 }  // namespace
 
 std::vector<std::string> ListSequenceFrames(const std::string& dir_or_list) {
-  if (!fs::exists(dir_or_list)) {
+  if (!PathExists(dir_or_list)) {
     ThrowInputError(dir_or_list, "sequence", "a directory of frames or a text file with one FRAME per line",
                     "no such file or directory");
   }
-  if (!fs::is_directory(dir_or_list)) {
+  if (!IsDirectory(dir_or_list)) {
     std::vector<std::string> frames = ListFileFrames(dir_or_list);
     if (frames.empty()) ThrowInputError(dir_or_list, "sequence", "at least one FRAME line", "none");
     return frames;
   }
   fs::path directory(dir_or_list);
   if (!directory.has_filename()) directory = directory.parent_path();  // "dir/" -> "dir"
-  if (fs::exists(directory / "scene_camera.json")) return ListBopSceneFrames(directory);
+  if (PathExists(directory / "scene_camera.json")) return ListBopSceneFrames(directory);
   std::vector<std::string> frames = ListDirectoryFrames(directory);
   if (frames.empty()) {
     ThrowInputError(dir_or_list, "sequence",

@@ -33,6 +33,7 @@
 #include "core/pose.h"
 #include "io/frame_io.h"
 #include "io/mesh_blob.h"
+#include "io/paths.h"
 #include "io/ply_check.h"
 
 namespace ecv {
@@ -76,7 +77,7 @@ void LoadTexture(const fs::path& mesh_dir, const std::string& mesh_path, const M
   std::replace(relative.begin(), relative.end(), '\\', '/');
   const fs::path file = mesh_dir / relative;
   material->texture_path = file.string();
-  if (!fs::exists(file)) {
+  if (!PathExists(file)) {
     const std::string message =
         mesh_path + ": material '" + material->name + "': texture '" + name + "' not found at " + file.string();
     if (!options.allow_missing_textures) {
@@ -194,7 +195,7 @@ std::string FindMeshImporter(std::vector<std::string>* tried) {
     candidates.emplace_back(ECV_MESH_IMPORTER_BUILT);
   }
   for (const std::string& candidate : candidates) {
-    if (access(candidate.c_str(), X_OK) == 0 && !fs::is_directory(candidate)) return candidate;
+    if (access(candidate.c_str(), X_OK) == 0 && !IsDirectory(candidate)) return candidate;
   }
   *tried = candidates;
   return {};
@@ -330,7 +331,7 @@ void CheckObjMaterials(const std::string& path, const MeshLoadOptions& options, 
     std::getline(words >> std::ws, library);
     library = Trim(library);
     const fs::path file = fs::path(path).parent_path() / library;
-    if (library.empty() || fs::exists(file)) continue;
+    if (library.empty() || PathExists(file)) continue;
     const std::string message = path + ": material library '" + library + "' not found at " + file.string();
     if (!options.allow_missing_textures) {
       throw InputError(message + " (give --allow-missing-textures to build it with default colours)");
@@ -400,8 +401,8 @@ bool LooksLikeMesh(const std::string& path) {
 
 TriangleMesh LoadMesh(const std::string& path, const MeshLoadOptions& options, std::vector<std::string>* warnings) {
   options.Check();
-  if (!fs::exists(path)) ThrowInputError(path, "mesh", "an existing file", "no such file");
-  if (fs::is_directory(path)) ThrowInputError(path, "mesh", "a mesh file", "a directory");
+  if (!PathExists(path)) ThrowInputError(path, "mesh", "an existing file", "no such file");
+  if (IsDirectory(path)) ThrowInputError(path, "mesh", "a mesh file", "a directory");
   const std::string extension = Lowercase(fs::path(path).extension().string());
   if (extension == ".ply") CheckPlyFile(path);
   if (extension == ".obj") CheckObjMaterials(path, options, warnings);

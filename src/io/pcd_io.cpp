@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "io/frame_io.h"
+#include "io/paths.h"
 #include "io/pcd_file.h"
 #include "io/points_io.h"
 
@@ -23,7 +24,7 @@ std::array<const PcdField*, 3> XyzFields(const std::string& path, const PcdLayou
 }
 
 PcdCloud ReadExisting(const std::string& path) {
-  if (!std::filesystem::exists(path)) ThrowInputError(path, "point cloud", "an existing .pcd file", "no such file");
+  if (!PathExists(path)) ThrowInputError(path, "point cloud", "an existing .pcd file", "no such file");
   return ReadPcdFile(path);
 }
 

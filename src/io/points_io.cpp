@@ -5,11 +5,12 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "io/paths.h"
 
 namespace ecv {
 
 std::vector<Eigen::Vector3d> ReadXyzFile(const std::string& path, double metres_per_unit) {
-  if (!std::filesystem::exists(path)) ThrowInputError(path, "points", "an existing file", "no such file");
+  if (!PathExists(path)) ThrowInputError(path, "points", "an existing file", "no such file");
   std::ifstream stream(path);
   std::vector<Eigen::Vector3d> points;
   std::string line;

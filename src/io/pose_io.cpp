@@ -6,6 +6,7 @@
 #include "core/error.h"
 #include "core/pose.h"
 #include "io/atomic_file.h"
+#include "io/paths.h"
 
 namespace ecv {
 
@@ -43,7 +44,7 @@ void WritePoseFile(const std::string& path, const std::map<std::string, Eigen::I
 }
 
 nlohmann::json ReadJsonFile(const std::string& path) {
-  if (!std::filesystem::exists(path)) ThrowInputError(path, "JSON file", "an existing file", "no such file");
+  if (!PathExists(path)) ThrowInputError(path, "JSON file", "an existing file", "no such file");
   std::ifstream stream(path);
   if (!stream) ThrowInputError(path, "JSON file", "a readable file");
   try {

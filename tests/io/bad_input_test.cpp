@@ -51,6 +51,21 @@ TEST_F(BadInput, MissingFile) {
               AllOf(HasSubstr(spec.positional), HasSubstr("YCB-Video prefix"), HasSubstr("BOP image")));
 }
 
+// Paths the system cannot look at (a name longer than it allows) are missing files, never another kind of exception.
+TEST_F(BadInput, APathTooLongForTheSystemIsAMissingFile) {
+  const std::string too_long = temporary_.File(std::string(300, 'c') + "-color.png");
+  EXPECT_THAT(InputErrorMessage([&] { MakeFrame(too_long, depth_, 10000, intrinsics_, "test"); }),
+              AllOf(HasSubstr(too_long), HasSubstr("no such file")));
+  const std::string path = temporary_.File("frame.json");
+  WriteText(path, R"({"color": ")" + std::string(300, 'c') +
+                      R"(.png", "depth": "b.png", "depth_scale": 1000, "camera": [1, 2, 3, 4]})");
+  EXPECT_THAT(InputErrorMessage([&] { LoadFrameJson(path); }), HasSubstr("no such file"));
+  FrameSpec spec;
+  spec.positional = temporary_.File(std::string(300, 'p') + "/000001");
+  EXPECT_THAT(InputErrorMessage([&] { LoadFrame(spec); }), HasSubstr(spec.positional));
+  EXPECT_THAT(InputErrorMessage([&] { ReadJsonFile(too_long); }), HasSubstr("no such file"));
+}
+
 TEST_F(BadInput, EightBitDepthWhereSixteenBitIsExpected) {
   const std::string depth8 = temporary_.File("depth8.png");
   cv::imwrite(depth8, cv::Mat(480, 640, CV_8UC1, cv::Scalar(100)));

@@ -111,6 +111,28 @@ TEST_F(MalformedMesh, AnObjWhoseMaterialLibraryIsMissingIsRefusedOrWarnedAbout) 
   EXPECT_NE(warnings[0].find("gone.mtl"), std::string::npos) << warnings[0];
 }
 
+// A material library or texture named longer than the system allows a file name is missing, not a crash: the file
+// system's "name too long" must not escape as another kind of exception (found by fuzz_mesh).
+TEST_F(MalformedMesh, AMaterialOrTextureNameTooLongForTheSystemIsMissing) {
+  const std::string long_name(300, 'm');
+  const std::string obj = Write("long.obj", "mtllib " + long_name + ".mtl\nv 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nf 1 2 3\n");
+  const std::string message = Refusal(obj);
+  EXPECT_NE(message.find(long_name), std::string::npos) << message;
+  EXPECT_NE(message.find("not found"), std::string::npos) << message;
+
+  Write("textured.mtl", "newmtl skin\nKd 1 1 1\nmap_Kd " + long_name + ".png\n");
+  const std::string textured = Write("textured.obj",
+                                     "mtllib textured.mtl\nv 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
+                                     "usemtl skin\nf 1/1 2/2 3/3\n");
+  const std::string texture_message = Refusal(textured);
+  EXPECT_NE(texture_message.find(long_name + ".png"), std::string::npos) << texture_message;
+  MeshLoadOptions allow;
+  allow.allow_missing_textures = true;
+  std::vector<std::string> warnings;
+  EXPECT_EQ(LoadMesh(textured, allow, &warnings).NumTriangles(), 1U);
+  EXPECT_EQ(warnings.size(), 1U);
+}
+
 // A truncated ASCII PLY under a name that is not .ply skips ecvpose's own PLY check and reaches the importer, whose
 // triangulation fails an assertion on it (Debian 12's assimp 5.2.5; in the importer's process this was a crash). The
 // importer runs in a child process, and its failure comes back as an error naming the file.

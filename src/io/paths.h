@@ -1,0 +1,15 @@
+#pragma once
+
+#include <filesystem>
+
+namespace ecv {
+
+/// Whether `path` names an existing file or folder. Never throws: a path that cannot be looked at (a name longer than
+/// the system allows, a folder without search permission) counts as missing, so that the caller's "no such file"
+/// error names it; std::filesystem::exists would throw filesystem_error instead.
+bool PathExists(const std::filesystem::path& path);
+
+/// Whether `path` names an existing folder; false, never a throw, where it cannot be looked at.
+bool IsDirectory(const std::filesystem::path& path);
+
+}  // namespace ecv
