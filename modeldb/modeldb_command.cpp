@@ -15,6 +15,7 @@
 #include "io/frame_io.h"
 #include "io/ply_io.h"
 #include "io/pose_io.h"
+#include "modeldb/library_build.h"
 #include "modeldb/mesh_sources.h"
 #include "modeldb/model_builder.h"
 #include "modeldb/model_database.h"
@@ -109,20 +110,22 @@ ModelSource SourceDefaults(const ModeldbArgs& args) {
   return defaults;
 }
 
-// Builds and stores one model; returns false (after reporting) when it failed.
-bool BuildOne(const ModelSource& source, const ModelBuildOptions& options, const std::string& tag, Renderer& renderer,
-              ModelDatabase& database) {
-  const std::string prefix = "modeldb: " + tag + " " + source.name;
-  std::cerr << prefix << ": building " << options.sampling.num_views << " views of " << source.mesh_path << '\n';
-  try {
-    const BuildResult built = BuildModel(source, options, renderer, [&](const BuildProgress& p) {
-      std::cerr << prefix << ": view " << p.view << "/" << p.num_views << ": " << p.primitives << " primitives, "
-                << p.descriptors << " descriptors\n";
-    });
-    for (const std::string& warning : built.warnings) std::cerr << prefix << ": warning: " << warning << '\n';
-    const AddModelResult added = database.AddModel(built.record);
+// Progress on stderr: a line per view and per model stored, a FAILED line per model that could not be built.
+LibraryBuildReporter BuildReporter(const ModelBuildOptions& options) {
+  const auto prefix = std::make_shared<std::string>();
+  LibraryBuildReporter reporter;
+  reporter.started = [prefix, views = options.sampling.num_views](const ModelSource& source, int number, int count) {
+    *prefix = "modeldb: [" + std::to_string(number) + "/" + std::to_string(count) + "] " + source.name;
+    std::cerr << *prefix << ": building " << views << " views of " << source.mesh_path << '\n';
+  };
+  reporter.progress = [prefix](const ModelSource&, const BuildProgress& p) {
+    std::cerr << *prefix << ": view " << p.view << "/" << p.num_views << ": " << p.primitives << " primitives, "
+              << p.descriptors << " descriptors\n";
+  };
+  reporter.stored = [prefix](const ModelSource&, const BuildResult& built, const AddModelResult& added) {
+    for (const std::string& warning : built.warnings) std::cerr << *prefix << ": warning: " << warning << '\n';
     const BuildTimings& t = built.timings;
-    std::cerr << prefix << ": stored " << built.record.views.size() << " views, " << built.record.NumPrimitives()
+    std::cerr << *prefix << ": stored " << built.record.views.size() << " views, " << built.record.NumPrimitives()
               << " primitives, " << built.record.NumDescriptors() << " descriptors (render "
               << Fixed(t.render_ms / 1000, 1) << " s, extract " << Fixed(t.extract_ms / 1000, 1) << " s, describe "
               << Fixed(t.describe_ms / 1000, 1) << " s, insert " << Fixed(added.insert_ms / 1000, 1) << " s)"
@@ -132,13 +135,11 @@ bool BuildOne(const ModelSource& source, const ModelBuildOptions& options, const
               << (added.replaced ? "; replaced the earlier model" : "")
               << (added.color_matrix_kept ? ", kept its colour matrix" : "")
               << (added.color_matrix_dropped ? ", dropped its colour matrix (the mesh changed)" : "") << '\n';
-    return true;
-  } catch (const InputError& error) {
-    std::cerr << prefix << ": FAILED: " << error.what() << '\n';
-  } catch (const SqlError& error) {
-    std::cerr << prefix << ": FAILED: " << error.what() << '\n';
-  }
-  return false;
+  };
+  reporter.failed = [prefix](const ModelSource&, const std::string& message) {
+    std::cerr << *prefix << ": FAILED: " << message << '\n';
+  };
+  return reporter;
 }
 
 int RunBuild(const ModeldbArgs& args) {
@@ -155,22 +156,16 @@ int RunBuild(const ModeldbArgs& args) {
     return kExitBadUsage;
   }
   for (const std::string& problem : scan.problems) std::cerr << "modeldb: FAILED: " << problem << '\n';
-  ModelDatabase database(args.db, OpenMode::kCreate);  // before rendering: a bad --db fails at once
-  Renderer renderer;
-  std::vector<std::string> failed;
-  for (size_t i = 0; i < scan.sources.size(); ++i) {
-    const std::string tag = "[" + std::to_string(i + 1) + "/" + std::to_string(scan.sources.size()) + "]";
-    if (!BuildOne(scan.sources[i], options, tag, renderer, database)) failed.push_back(scan.sources[i].name);
-  }
-  const size_t built = scan.sources.size() - failed.size();
-  std::cout << "built " << built << " of " << scan.sources.size() + scan.problems.size() << " models into " << args.db;
-  if (!failed.empty() || !scan.problems.empty()) {
+  const LibraryBuildSummary summary = BuildLibrary(args.db, scan.sources, options, BuildReporter(options));
+  std::cout << "built " << summary.built.size() << " of " << scan.sources.size() + scan.problems.size()
+            << " models into " << args.db;
+  if (!summary.failed.empty() || !scan.problems.empty()) {
     std::cout << "; failed (see above):";
-    for (const std::string& name : failed) std::cout << ' ' << name;
+    for (const std::string& name : summary.failed) std::cout << ' ' << name;
     for (const std::string& problem : scan.problems) std::cout << ' ' << problem.substr(0, problem.find(':'));
   }
   std::cout << '\n';
-  return failed.empty() && scan.problems.empty() && built > 0 ? kExitOk : kExitBadInput;
+  return summary.failed.empty() && scan.problems.empty() && !summary.built.empty() ? kExitOk : kExitBadInput;
 }
 
 nlohmann::ordered_json SummaryJson(const ModelSummary& m) {

@@ -1,0 +1,36 @@
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "modeldb/model_builder.h"
+#include "modeldb/model_database.h"
+
+namespace ecv {
+
+/// What BuildLibrary says as it goes; any of them may be left empty.
+struct LibraryBuildReporter {
+  /// A model's build starts: its source and its place among them, 1..count.
+  std::function<void(const ModelSource& source, int number, int count)> started;
+  std::function<void(const ModelSource& source, const BuildProgress& progress)> progress;  ///< after each view
+  /// The model is stored: what was built and how the library took it.
+  std::function<void(const ModelSource& source, const BuildResult& built, const AddModelResult& added)> stored;
+  /// The model could not be built or stored; `message` names the file and what was wrong.
+  std::function<void(const ModelSource& source, const std::string& message)> failed;
+};
+
+/// The models BuildLibrary stored, and those it could not.
+struct LibraryBuildSummary {
+  std::vector<std::string> built;   ///< names
+  std::vector<std::string> failed;  ///< names
+};
+
+/// Builds each of `sources` (BuildModel) and stores it in the library at `db_path`, created if missing and opened
+/// before any rendering, so that a bad path fails at once (InputError or SqlError). Each model is stored in one
+/// transaction and replaces a model of its name; one that fails (a bad mesh, a library that refuses it) is reported
+/// and the others are still built.
+LibraryBuildSummary BuildLibrary(const std::string& db_path, const std::vector<ModelSource>& sources,
+                                 const ModelBuildOptions& options, const LibraryBuildReporter& reporter = {});
+
+}  // namespace ecv

@@ -1,0 +1,47 @@
+#pragma once
+
+#include <pybind11/pybind11.h>
+
+namespace ecv::python {
+
+namespace py = pybind11;
+
+/// ModelLibrary, Model, build_models and render.
+void BindLibrary(py::module_& m);
+
+/// Frame, load_frame, Detection and Recognizer.
+void BindRecognizer(py::module_& m);
+
+inline constexpr const char* kBuildModelsDoc = R"(Builds a model library from meshes, as `ecvpose modeldb build` does.
+
+db: the library's path (created if missing; a model of the same name is replaced).
+meshes: a mesh file or a directory of <name>/<name>.obj folders, or a list of them.
+name: the model's name (one mesh only; default: the file stem or folder name).
+unit: "m", "cm" or "mm", the unit of the mesh's coordinates.
+object_from_mesh: a 4x4 pose or the path of a JSON file with one ("object_from_mesh"); default: the
+    object_from_mesh.json beside each mesh, if there is one.
+symmetric: mark the models symmetric (evaluated with ADD-S).
+allow_missing_textures: build with default colours where a texture or material file is missing.
+views, distance: rendered views per model, and their distance from the object centre in metres.
+camera, size: the views' 3x3 intrinsics (default: YCB-Video's) and (width, height).
+shading: "auto", "unlit" or "headlight".
+threads: worker threads (0: every core); the library is the same for any count.
+stored_mesh, mesh_texture_size: store each mesh in the library (textures at most this many pixels a side).
+feature_settings: a dict of extraction and descriptor settings as `ecvpose modeldb info` shows them.
+progress: called as progress(model, view, views) after each view.
+
+Returns the names of the models built. Raises InputError naming each model that failed, after building the others.)";
+
+inline constexpr const char* kRecognizerDoc = R"(A recognizer over `library`, as `ecvpose recognize` runs.
+
+threads, seed: worker threads (the result is the same for any count) and the random seed.
+track: follow objects from call to call (each previous detection tried first at its pose); search_every: with
+    track, models not tracked are searched on every N-th call only; track_score: a detection is followed only
+    while it scores at least this; confirm_every: a track's model is searched again after this many frames.
+hypotheses: "context", "ppf" or "both": where poses come from.
+views_per_model, min_score, max_instances, preselect: the search (as the recognize flags of those names).
+icp, contour, edge_weight, matcher: refinement and verification ("kd-forest" or "bytes").
+
+Loads the models' meshes for verification (about a second for seven models).)";
+
+}  // namespace ecv::python

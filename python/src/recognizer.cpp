@@ -1,0 +1,257 @@
+// The Python module's Frame, load_frame, Detection and Recognizer.
+
+#include <map>
+#include <memory>
+#include <mutex>
+#include <sstream>
+#include <string>
+
+#include <pybind11/stl.h>
+
+#include "arrays.h"
+#include "bindings.h"
+#include "core/error.h"
+#include "io/frame_io.h"
+#include "library.h"
+#include "recognize/recognition_stream.h"
+#include "recognize/recognizer.h"
+
+namespace ecv::python {
+namespace {
+
+// A Recognizer with its library and its stream of frames: one call at a time (the renderer is not shared).
+class StreamRecognizer {
+ public:
+  StreamRecognizer(std::shared_ptr<Library> library, const RecognizerOptions& options, const StreamOptions& stream)
+      : library_(std::move(library)), recognizer_(library_->library(), options), stream_(recognizer_, stream) {}
+
+  RecognitionResult Recognize(const RgbdFrame& frame) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    RecognitionResult result = stream_.Next(frame);
+    last_timings_ms_ = result.timings_ms;
+    return result;
+  }
+
+  void Reset() {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    stream_.Reset();
+  }
+
+  std::map<std::string, double> last_timings_ms() {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    return last_timings_ms_;
+  }
+
+  std::vector<std::string> PointPairWarnings() const { return recognizer_.PointPairWarnings(); }
+
+ private:
+  std::shared_ptr<Library> library_;  // the recognizer reads it
+  Recognizer recognizer_;
+  RecognitionStream stream_;
+  std::mutex mutex_;
+  std::map<std::string, double> last_timings_ms_;
+};
+
+// The Recognizer's keyword arguments: the flags of `ecvpose recognize`.
+struct RecognizeArguments {
+  int threads = 2;
+  uint64_t seed = 1;
+  bool track = false;
+  int search_every = 1;
+  RecognizerOptions options;
+};
+
+std::unique_ptr<StreamRecognizer> MakeRecognizer(std::shared_ptr<Library> library, RecognizeArguments args) {
+  args.options.ransac.threads = args.threads;
+  args.options.ransac.seed = args.seed;
+  args.options.Check();
+  StreamOptions stream;
+  stream.track = args.track;
+  stream.search_every = args.search_every;
+  stream.Check();
+  if (library->library().models().empty()) {
+    ThrowInputError(library->path(), "models", "a library with at least one model", "none");
+  }
+  py::gil_scoped_release release;  // the meshes are loaded and uploaded: about a second
+  return std::make_unique<StreamRecognizer>(std::move(library), args.options, stream);
+}
+
+// A keyword argument outside [low, high] is an InputError naming it.
+void CheckRange(const char* name, double value, double low, double high) {
+  if (!(value >= low && value <= high)) {
+    std::ostringstream expected, got;
+    expected << "a value in [" << low << ", " << high << "]";
+    got << value;
+    ThrowInputError(name, "", expected.str(), got.str());
+  }
+}
+
+py::list DetectionList(const RecognitionResult& result) {
+  py::list detections;
+  for (const Detection& detection : result.detections) detections.append(detection);
+  return detections;
+}
+
+py::list RecognizeArrays(StreamRecognizer& recognizer, const py::array& color, const py::array& depth,
+                         const py::object& k, const py::object& depth_scale) {
+  RgbdFrame frame;
+  frame.name = "Recognizer.recognize";
+  frame.color = ColorImage(color, "color");
+  frame.depth = DepthImage(depth, depth_scale, "depth");
+  frame.camera = CameraFromK(k, frame.color.cols, frame.color.rows, "K");
+  RecognitionResult result;
+  {
+    py::gil_scoped_release release;
+    frame.Check();
+    result = recognizer.Recognize(frame);
+  }
+  return DetectionList(result);
+}
+
+py::list GroundTruthList(const LoadedFrame& frame) {
+  py::list truth;
+  for (const GroundTruth& object : frame.ground_truth) {
+    truth.append(py::make_tuple(object.object_name, PoseArray(object.camera_from_object)));
+  }
+  return truth;
+}
+
+LoadedFrame LoadFrameSpec(const std::optional<std::string>& spec, const std::optional<std::string>& color,
+                          const std::optional<std::string>& depth, std::optional<double> depth_scale,
+                          const std::optional<std::string>& camera) {
+  FrameSpec frame;
+  frame.positional = spec.value_or("");
+  frame.color_path = color.value_or("");
+  frame.depth_path = depth.value_or("");
+  frame.depth_scale = depth_scale;
+  frame.camera = camera;
+  if (frame.positional.empty() && (frame.color_path.empty() || frame.depth_path.empty())) {
+    ThrowInputError("load_frame", "spec",
+                    "a FRAME (frame JSON, YCB-Video prefix, BOP SCENE_DIR:IMAGE_ID or .pcd), "
+                    "or color= and depth= (with depth_scale= and camera=)");
+  }
+  py::gil_scoped_release release;
+  return LoadFrame(frame);
+}
+
+void BindDetection(py::module_& m) {
+  py::class_<Detection>(m, "Detection", "One recognised object.")
+      .def_readonly("model", &Detection::model)
+      .def_readonly("score", &Detection::score, "0..1, higher is surer")
+      .def_property_readonly(
+          "camera_from_object", [](const Detection& d) { return PoseArray(d.camera_from_object); },
+          "4x4 float64: x_camera = R x_object + t, metres")
+      .def_readonly("inlier_fraction", &Detection::inlier_fraction)
+      .def_readonly("fit_error_m", &Detection::fit_error_m)
+      .def_readonly("view", &Detection::view)
+      .def_readonly("depth_agreement", &Detection::depth_agreement)
+      .def_readonly("color_agreement", &Detection::color_agreement)
+      .def_readonly("surface_error_m", &Detection::surface_error_m)
+      .def_readonly("contour_agreement", &Detection::contour_agreement)
+      .def_readonly("visible_fraction", &Detection::visible_fraction)
+      .def_readonly("edge_agreement", &Detection::edge_agreement)
+      .def_readonly("edge_pixels", &Detection::edge_pixels)
+      .def_readonly("tracked", &Detection::tracked)
+      .def_readonly("frames_followed", &Detection::frames_followed)
+      .def_property_readonly("hypothesis", [](const Detection& d) { return HypothesisSourceName(d.hypothesis); })
+      .def("__repr__", [](const Detection& d) {
+        const Eigen::Vector3d t = d.camera_from_object.translation();
+        return "<ecvpose.Detection " + d.model + " score " + std::to_string(d.score) + " at (" + std::to_string(t.x()) +
+               ", " + std::to_string(t.y()) + ", " + std::to_string(t.z()) + ") m" + (d.tracked ? ", tracked>" : ">");
+      });
+}
+
+void BindFrame(py::module_& m) {
+  py::class_<LoadedFrame>(m, "Frame", "An RGB-D frame read from files, with its ground truth if it has one.")
+      .def_property_readonly(
+          "color", [](const LoadedFrame& f) { return ImageArray(f.rgbd.color); }, "HxWx3 uint8, RGB")
+      .def_property_readonly(
+          "depth", [](const LoadedFrame& f) { return ImageArray(f.rgbd.depth); },
+          "HxW float32, metres, 0 where missing")
+      .def_property_readonly(
+          "K", [](const LoadedFrame& f) { return KArray(f.rgbd.camera); }, "3x3 float64")
+      .def_property_readonly("name", [](const LoadedFrame& f) { return f.rgbd.name; })
+      .def_property_readonly("ground_truth", &GroundTruthList, "[(model, camera_from_object 4x4)]")
+      .def("__repr__", [](const LoadedFrame& f) {
+        return "<ecvpose.Frame " + f.rgbd.name + ", " + std::to_string(f.rgbd.color.cols) + "x" +
+               std::to_string(f.rgbd.color.rows) + ">";
+      });
+
+  m.def("load_frame", &LoadFrameSpec, py::arg("spec") = py::none(), py::kw_only(), py::arg("color") = py::none(),
+        py::arg("depth") = py::none(), py::arg("depth_scale") = py::none(), py::arg("camera") = py::none(),
+        "Reads a frame as the CLI names it: `spec` a frame JSON, a YCB-Video prefix (.../0001/000001), a BOP "
+        "image SCENE_DIR:IMAGE_ID or an organized .pcd; or color= and depth= (16-bit PNG) with depth_scale= (units "
+        "per metre) and camera= (\"fx,fy,cx,cy\").");
+}
+
+}  // namespace
+
+void BindRecognizer(py::module_& m) {
+  BindDetection(m);
+  BindFrame(m);
+  const RecognizerOptions defaults;
+  py::class_<StreamRecognizer>(m, "Recognizer", "Finds a library's models in RGB-D frames.")
+      .def(py::init([](std::shared_ptr<Library> library, int threads, uint64_t seed, bool track, int search_every,
+                       double track_score, int confirm_every, std::string hypotheses, int views_per_model,
+                       double min_score, int max_instances, int preselect, bool icp, bool contour, double edge_weight,
+                       std::string matcher) {
+             CheckRange("threads", threads, 1, 1024);
+             CheckRange("search_every", search_every, 1, 1e9);
+             CheckRange("track_score", track_score, 0, 1);
+             CheckRange("confirm_every", confirm_every, 0, 1e9);
+             CheckRange("views_per_model", views_per_model, 1, 1e9);
+             CheckRange("min_score", min_score, 0, 1);
+             CheckRange("max_instances", max_instances, 1, 1e9);
+             CheckRange("preselect", preselect, 0, 1e9);
+             CheckRange("edge_weight", edge_weight, 0, 1);
+             RecognizeArguments args{threads, seed, track, search_every, RecognizerOptions{}};
+             RecognizerOptions& o = args.options;
+             o.tracking.min_follow_score = track_score;
+             o.tracking.confirm_every = confirm_every;
+             o.point_pairs.source = ParseHypothesisSource(hypotheses, "hypotheses");
+             o.views_per_model = views_per_model;
+             o.verify.min_score = min_score;
+             o.max_instances = max_instances;
+             o.preselect.models = preselect;
+             o.refine = icp;
+             if (!contour) o.verify.contour_falloff = 0.0;
+             o.verify.edge_weight = edge_weight;
+             if (matcher != "kd-forest" && matcher != "bytes") {
+               ThrowInputError("matcher", "", "kd-forest or bytes", matcher);
+             }
+             if (matcher == "bytes") o.match.index = MatchIndex::kBytes;
+             return MakeRecognizer(std::move(library), std::move(args));
+           }),
+           py::arg("library"), py::kw_only(), py::arg("threads") = 2, py::arg("seed") = 1, py::arg("track") = false,
+           py::arg("search_every") = 1, py::arg("track_score") = defaults.tracking.min_follow_score,
+           py::arg("confirm_every") = defaults.tracking.confirm_every,
+           py::arg("hypotheses") = HypothesisSourceName(defaults.point_pairs.source),
+           py::arg("views_per_model") = defaults.views_per_model, py::arg("min_score") = defaults.verify.min_score,
+           py::arg("max_instances") = defaults.max_instances, py::arg("preselect") = defaults.preselect.models,
+           py::arg("icp") = true, py::arg("contour") = true, py::arg("edge_weight") = defaults.verify.edge_weight,
+           py::arg("matcher") = "kd-forest", kRecognizerDoc)
+      .def("recognize", &RecognizeArrays, py::arg("color"), py::arg("depth"), py::arg("K"),
+           py::arg("depth_scale") = py::none(),
+           "Detections in one frame, best score first. color: HxWx3 uint8 RGB; depth: HxW float32 metres (0: "
+           "missing), or uint16 with depth_scale (units per metre); K: 3x3 intrinsics. The arrays are read in "
+           "place where their layout allows. With track=True, the frame continues the stream of earlier calls.")
+      .def(
+          "recognize_frame",
+          [](StreamRecognizer& recognizer, const LoadedFrame& frame) {
+            RecognitionResult result;
+            {
+              py::gil_scoped_release release;
+              result = recognizer.Recognize(frame.rgbd);
+            }
+            return DetectionList(result);
+          },
+          py::arg("frame"), "recognize() on a Frame from load_frame.")
+      .def("reset", &StreamRecognizer::Reset, py::call_guard<py::gil_scoped_release>(),
+           "Forgets the tracks: the next frame searches every model (a new video).")
+      .def_property_readonly("last_timings_ms", &StreamRecognizer::last_timings_ms,
+                             "Time per stage of the last frame, milliseconds (\"total\": the whole call in C++).")
+      .def_property_readonly("point_pair_warnings", &StreamRecognizer::PointPairWarnings,
+                             "Models without a point pair table, and why (with hypotheses \"ppf\" or \"both\").");
+}
+
+}  // namespace ecv::python

@@ -1,0 +1,31 @@
+"""Shared fixtures: the demo data of the checkout and a library of its three meshes, built once per test file."""
+
+import os
+import pathlib
+
+import pytest
+
+import ecvpose
+
+SOURCE_DIR = pathlib.Path(os.environ.get("ECVPOSE_SOURCE_DIR", pathlib.Path(__file__).resolve().parents[2]))
+DEMO_FRAME = str(SOURCE_DIR / "models" / "frame" / "000001")
+DEMO_MESHES = str(SOURCE_DIR / "models" / "meshes")
+DATA_DIR = pathlib.Path(os.environ.get("ECVPOSE_DATA_DIR", SOURCE_DIR.parent / "shared" / "data"))
+
+
+@pytest.fixture(scope="module")
+def demo_library_path(tmp_path_factory):
+    """The library of models/meshes as the demo builds it: 40 views at 0.9 m."""
+    path = tmp_path_factory.mktemp("library") / "demo.sqlite"
+    ecvpose.build_models(str(path), DEMO_MESHES, views=40, distance=0.9)
+    return path
+
+
+@pytest.fixture(scope="module")
+def demo_library(demo_library_path):
+    return ecvpose.ModelLibrary.open(str(demo_library_path))
+
+
+@pytest.fixture(scope="module")
+def demo_frame():
+    return ecvpose.load_frame(DEMO_FRAME)
