@@ -33,3 +33,28 @@ run("${work}/prefix/bin/ecvpose" info "${SOURCE_DIR}/models/meshes/003_cracker_b
 if(NOT output MATCHES "triangles")
   message(FATAL_ERROR "unexpected output of the installed ecvpose info: ${output}")
 endif()
+
+# The installed Python package imports from the prefix's dist-packages (its libraries found there) and builds a
+# model through the installed mesh importer.
+if(EXISTS "${BUILD_DIR}/python/ecvpose/__init__.py")
+  file(GLOB_RECURSE python_init "${work}/prefix/lib/*/__init__.py")
+  list(FILTER python_init INCLUDE REGEX "dist-packages/ecvpose/__init__.py$")
+  if(NOT python_init)
+    message(FATAL_ERROR "the build has the Python package, the install has no dist-packages/ecvpose")
+  endif()
+  get_filename_component(package_dir "${python_init}" DIRECTORY)
+  get_filename_component(dist_packages "${package_dir}" DIRECTORY)
+  file(WRITE "${work}/check.py" [[
+import sys
+import ecvpose
+assert ecvpose.__file__.startswith(sys.argv[1]), ecvpose.__file__
+ecvpose.build_models(sys.argv[2], sys.argv[3], views=4)
+print([model.name for model in ecvpose.ModelLibrary.open(sys.argv[2]).models])
+]])
+  run(${CMAKE_COMMAND} -E env "PYTHONPATH=${dist_packages}" /usr/bin/python3 "${work}/check.py" "${work}/prefix"
+      "${work}/python.sqlite" "${SOURCE_DIR}/models/meshes/004_sugar_box")
+  if(NOT output MATCHES "004_sugar_box")
+    message(FATAL_ERROR "unexpected output of the installed Python package: ${output}")
+  endif()
+  message(STATUS "installed Python package built: ${output}")
+endif()
