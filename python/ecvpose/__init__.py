@@ -23,8 +23,10 @@ from ._ecvpose import (  # noqa: F401
     RenderError,
     __version__,
     build_models,
+    list_frames,
     load_frame,
     render,
+    write_image,
 )
 
 __all__ = [
@@ -37,6 +39,8 @@ __all__ = [
     "RenderError",
     "__version__",
     "build_models",
+    "list_frames",
     "load_frame",
     "render",
+    "write_image",
 ]

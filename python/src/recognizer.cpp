@@ -42,6 +42,11 @@ class StreamRecognizer {
     return last_timings_ms_;
   }
 
+  cv::Mat Draw(const RgbdFrame& frame, const std::vector<Detection>& detections) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    return recognizer_.DrawDetections(frame, detections);
+  }
+
   std::vector<std::string> PointPairWarnings() const { return recognizer_.PointPairWarnings(); }
 
  private:
@@ -92,17 +97,25 @@ py::list DetectionList(const RecognitionResult& result) {
   return detections;
 }
 
-py::list RecognizeArrays(StreamRecognizer& recognizer, const py::array& color, const py::array& depth,
-                         const py::object& k, const py::object& depth_scale) {
+// A frame of the caller's arrays, checked; `name` (the method) leads the messages about it.
+RgbdFrame FrameFromArrays(const py::array& color, const py::array& depth, const py::object& k,
+                          const py::object& depth_scale, const std::string& name) {
   RgbdFrame frame;
-  frame.name = "Recognizer.recognize";
+  frame.name = name;
   frame.color = ColorImage(color, "color");
   frame.depth = DepthImage(depth, depth_scale, "depth");
   frame.camera = CameraFromK(k, frame.color.cols, frame.color.rows, "K");
+  py::gil_scoped_release release;
+  frame.Check();
+  return frame;
+}
+
+py::list RecognizeArrays(StreamRecognizer& recognizer, const py::array& color, const py::array& depth,
+                         const py::object& k, const py::object& depth_scale) {
+  const RgbdFrame frame = FrameFromArrays(color, depth, k, depth_scale, "Recognizer.recognize");
   RecognitionResult result;
   {
     py::gil_scoped_release release;
-    frame.Check();
     result = recognizer.Recognize(frame);
   }
   return DetectionList(result);
@@ -182,6 +195,17 @@ void BindFrame(py::module_& m) {
         "Reads a frame as the CLI names it: `spec` a frame JSON, a YCB-Video prefix (.../0001/000001), a BOP "
         "image SCENE_DIR:IMAGE_ID or an organized .pcd; or color= and depth= (16-bit PNG) with depth_scale= (units "
         "per metre) and camera= (\"fx,fy,cx,cy\").");
+  m.def("list_frames", &ListSequenceFrames, py::arg("sequence"), py::call_guard<py::gil_scoped_release>(),
+        "The frames of a sequence in order, each a spec for load_frame: a BOP scene folder, a YCB-Video video folder, "
+        "a folder of frame JSONs, or a text file with one FRAME per line.");
+  m.def(
+      "write_image",
+      [](const std::string& path, const py::array& color) {
+        const cv::Mat image = ColorImage(color, "color");
+        py::gil_scoped_release release;
+        WriteColorImage(path, image);
+      },
+      py::arg("path"), py::arg("color"), "Writes an HxWx3 uint8 RGB array as a PNG or JPG file.");
 }
 
 }  // namespace
@@ -246,6 +270,21 @@ void BindRecognizer(py::module_& m) {
             return DetectionList(result);
           },
           py::arg("frame"), "recognize() on a Frame from load_frame.")
+      .def(
+          "draw",
+          [](StreamRecognizer& recognizer, const py::array& color, const py::array& depth, const py::object& k,
+             const std::vector<Detection>& detections, const py::object& depth_scale) {
+            RgbdFrame frame = FrameFromArrays(color, depth, k, depth_scale, "Recognizer.draw");
+            cv::Mat drawn;
+            {
+              py::gil_scoped_release release;
+              drawn = recognizer.Draw(frame, detections);
+            }
+            return ImageArray(drawn);
+          },
+          py::arg("color"), py::arg("depth"), py::arg("K"), py::arg("detections"), py::arg("depth_scale") = py::none(),
+          "A copy of `color` with each detection's model rendered at its pose in red, outlined, with its name and "
+          "score; scene surfaces in front of a model (by `depth`) hide it.")
       .def("reset", &StreamRecognizer::Reset, py::call_guard<py::gil_scoped_release>(),
            "Forgets the tracks: the next frame searches every model (a new video).")
       .def_property_readonly("last_timings_ms", &StreamRecognizer::last_timings_ms,
