@@ -37,6 +37,7 @@ CommandAction SetupModeldbCommand(CLI::App& command);  // modeldb/modeldb_comman
 CommandAction SetupRegisterCommand(CLI::App& command);
 CommandAction SetupColorcalCommand(CLI::App& command);   // colorcal/colorcal_command.cpp
 CommandAction SetupRecognizeCommand(CLI::App& command);  // recognize/recognize_command.cpp
+CommandAction SetupServeCommand(CLI::App& command);      // recognize/serve_command.cpp
 CommandAction SetupEvalCommand(CLI::App& command);       // recognize/eval_command.cpp
 
 }  // namespace ecv::app

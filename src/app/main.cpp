@@ -31,6 +31,8 @@ const Subcommand kSubcommands[] = {
      ecv::app::SetupRegisterCommand},
     {"recognize", "Find the library's objects with their 6D poses in RGB-D frames; JSON and a picture",
      ecv::app::SetupRecognizeCommand},
+    {"serve", "Keep the library loaded and answer recognition requests, JSON lines on stdin or a Unix socket",
+     ecv::app::SetupServeCommand},
     {"eval", "Score detections against ground truth: rotation, translation, ADD, ADD-S, recall",
      ecv::app::SetupEvalCommand},
 };

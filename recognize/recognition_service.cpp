@@ -1,0 +1,115 @@
+#include "recognize/recognition_service.h"
+
+#include <algorithm>
+#include <set>
+#include <sstream>
+
+#include "core/error.h"
+#include "io/frame_io.h"
+
+namespace ecv {
+namespace {
+
+constexpr const char* kSource = "request";
+
+StreamOptions Tracking(StreamOptions stream) {
+  stream.track = true;
+  return stream;
+}
+
+// The frame a request names, as FrameSpec; InputError naming the key when it is missing or malformed.
+FrameSpec RequestedFrame(const nlohmann::json& request) {
+  FrameSpec spec;
+  if (request.contains("frame")) {
+    for (const char* key : {"color", "depth", "depth_scale", "camera"}) {
+      if (request.contains(key)) ThrowInputError(kSource, key, "\"frame\" or the four frame keys, not both");
+    }
+    if (!request["frame"].is_string()) ThrowInputError(kSource, "frame", "a FRAME string", request["frame"].dump());
+    spec.positional = request["frame"].get<std::string>();
+    return spec;
+  }
+  const auto text = [&](const char* key) {
+    if (!request.contains(key) || !request[key].is_string()) {
+      ThrowInputError(kSource, key, "a path string (or \"frame\": FRAME instead of the frame keys)");
+    }
+    return request[key].get<std::string>();
+  };
+  spec.color_path = text("color");
+  spec.depth_path = text("depth");
+  if (!request.contains("depth_scale") || !request["depth_scale"].is_number()) {
+    ThrowInputError(kSource, "depth_scale", "a number, depth units per metre");
+  }
+  spec.depth_scale = request["depth_scale"].get<double>();
+  const nlohmann::json& camera = request.contains("camera") ? request["camera"] : nlohmann::json();
+  if (!camera.is_array() || camera.size() != 4 ||
+      !std::all_of(camera.begin(), camera.end(), [](const nlohmann::json& v) { return v.is_number(); })) {
+    ThrowInputError(kSource, "camera", "[fx, fy, cx, cy] in pixels", camera.is_null() ? "" : camera.dump());
+  }
+  std::ostringstream intrinsics;
+  intrinsics.precision(17);
+  for (size_t i = 0; i < 4; ++i) intrinsics << (i > 0 ? "," : "") << camera[i].get<double>();
+  spec.camera = intrinsics.str();
+  return spec;
+}
+
+bool Flag(const nlohmann::json& request, const char* key, bool otherwise) {
+  if (!request.contains(key)) return otherwise;
+  if (!request[key].is_boolean()) ThrowInputError(kSource, key, "true or false", request[key].dump());
+  return request[key].get<bool>();
+}
+
+}  // namespace
+
+RecognitionService::RecognitionService(Recognizer& recognizer, const StreamOptions& stream)
+    : recognizer_(recognizer), track_by_default_(stream.track), stream_(recognizer, Tracking(stream)) {}
+
+nlohmann::json RecognitionService::Handle(const std::string& line) {
+  nlohmann::json request;
+  nlohmann::json id;
+  try {
+    try {
+      request = nlohmann::json::parse(line);
+    } catch (const nlohmann::json::exception& error) {
+      ThrowInputError(kSource, "JSON", "one JSON object per line", error.what());
+    }
+    if (!request.is_object()) ThrowInputError(kSource, "JSON", "an object", request.dump().substr(0, 80));
+    if (request.contains("id")) id = request["id"];
+    return Respond(request);
+  } catch (const InputError& error) {
+    return {{"id", id}, {"error", error.what()}};
+  }
+}
+
+nlohmann::json RecognitionService::Respond(const nlohmann::json& request) {
+  static const std::set<std::string> kKeys = {"id",          "frame",  "color", "depth",
+                                              "depth_scale", "camera", "track", "reset"};
+  for (const auto& [key, value] : request.items()) {
+    if (kKeys.count(key) == 0) {
+      ThrowInputError(kSource, key, "one of id, frame, color, depth, depth_scale, camera, track, reset",
+                      "an unknown key");
+    }
+  }
+  const FrameSpec spec = RequestedFrame(request);
+  const bool track = Flag(request, "track", track_by_default_);
+  if (Flag(request, "reset", false)) stream_.Reset();
+  LoadedFrame frame;
+  try {
+    frame = LoadFrame(spec);
+  } catch (const InputError&) {
+    stream_.Reset();  // as a broken frame of a sequence: the next tracked frame searches every model
+    throw;
+  }
+  RecognitionResult result;
+  if (track) {
+    result = stream_.Next(frame.rgbd);
+  } else {
+    stream_.Reset();  // a frame on its own: the tracks no longer describe the scene
+    result = recognizer_.Recognize(frame.rgbd);
+  }
+  nlohmann::json response = RecognitionToJson(result);
+  response["frame"] = spec.positional.empty() ? spec.color_path : spec.positional;
+  response["id"] = request.contains("id") ? request["id"] : nlohmann::json();
+  return response;
+}
+
+}  // namespace ecv

@@ -1,0 +1,178 @@
+// `ecvpose serve --db lib.sqlite`: one process that loads the library and the meshes once and answers recognition
+// requests, JSON lines on standard input or on a Unix socket (RecognitionService holds the protocol).
+
+#include <errno.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include <csignal>
+#include <cstring>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "app/commands.h"
+#include "core/error.h"
+#include "recognize/recognition_service.h"
+#include "recognize/recognize_flags.h"
+
+namespace ecv::app {
+namespace {
+
+constexpr size_t kMaxRequestBytes = 1 << 20;  // a request names files: a longer line is refused, not buffered
+
+volatile std::sig_atomic_t stop_requested = 0;
+
+// SIGTERM and SIGINT end the service after the request in hand; without SA_RESTART a blocking read or accept returns
+// EINTR, so that a service waiting for a request ends at once.
+void InstallStopHandlers() {
+  struct sigaction action {};
+  action.sa_handler = [](int) { stop_requested = 1; };
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = 0;
+  sigaction(SIGTERM, &action, nullptr);
+  sigaction(SIGINT, &action, nullptr);
+  signal(SIGPIPE, SIG_IGN);  // a client gone: its write fails with EPIPE instead of ending the service
+}
+
+struct ServeArgs {
+  RecognizerArgs recognizer;
+  std::string socket;
+};
+
+// Lines of a file descriptor, read as they arrive; nothing once the input ends or a stop is requested.
+class LineReader {
+ public:
+  explicit LineReader(int fd) : fd_(fd) {}
+
+  // The next line (without its newline); `too_long` is set for a line past kMaxRequestBytes, whose rest is skipped.
+  std::optional<std::string> Next(bool* too_long) {
+    *too_long = false;
+    while (true) {
+      const size_t newline = buffer_.find('\n');
+      if (newline != std::string::npos) {
+        std::string line = buffer_.substr(0, newline);
+        buffer_.erase(0, newline + 1);
+        if (skipping_) {
+          skipping_ = false;
+          *too_long = true;
+          return std::string();
+        }
+        return line;
+      }
+      if (buffer_.size() > kMaxRequestBytes) {
+        buffer_.clear();
+        skipping_ = true;
+      }
+      char chunk[65536];
+      const ssize_t got = read(fd_, chunk, sizeof(chunk));
+      if (got < 0 && errno == EINTR && !stop_requested) continue;
+      if (got <= 0 || stop_requested) return std::nullopt;
+      buffer_.append(chunk, static_cast<size_t>(got));
+    }
+  }
+
+ private:
+  int fd_;
+  std::string buffer_;
+  bool skipping_ = false;
+};
+
+// Writes all of `text`; false when the reader has gone.
+bool WriteAll(int fd, const std::string& text) {
+  size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t wrote = write(fd, text.data() + done, text.size() - done);
+    if (wrote < 0 && errno == EINTR) continue;
+    if (wrote <= 0) return false;
+    done += static_cast<size_t>(wrote);
+  }
+  return true;
+}
+
+// Answers the requests of one client, a line each, until its input ends, it goes or a stop is requested.
+void ServeClient(int in, int out, RecognitionService& service) {
+  LineReader reader(in);
+  bool too_long = false;
+  while (const std::optional<std::string> line = reader.Next(&too_long)) {
+    if (!too_long && line->find_first_not_of(" \t\r") == std::string::npos) continue;
+    const nlohmann::json response =
+        too_long ? nlohmann::json{{"id", nullptr}, {"error", "request: expected a line of at most 1 MiB"}}
+                 : service.Handle(*line);
+    if (!WriteAll(out, response.dump() + "\n") || stop_requested) return;
+  }
+}
+
+// A listening Unix socket at `path`; a stale socket file there is replaced, any other file is refused.
+int ListenOn(const std::string& path) {
+  sockaddr_un address{};
+  address.sun_family = AF_UNIX;
+  if (path.empty() || path.size() >= sizeof(address.sun_path)) {
+    ThrowInputError(path, "--socket", "a path of 1 to " + std::to_string(sizeof(address.sun_path) - 1) + " bytes");
+  }
+  struct stat status {};
+  if (lstat(path.c_str(), &status) == 0) {
+    if (!S_ISSOCK(status.st_mode)) ThrowInputError(path, "--socket", "a free path or a stale socket", "another file");
+    unlink(path.c_str());
+  }
+  std::memcpy(address.sun_path, path.c_str(), path.size());
+  const int fd = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  if (fd < 0 || bind(fd, reinterpret_cast<const sockaddr*>(&address), sizeof(address)) != 0 || listen(fd, 8) != 0) {
+    const std::string reason = std::strerror(errno);
+    if (fd >= 0) close(fd);
+    ThrowInputError(path, "--socket", "a path where a socket can be made", reason);
+  }
+  return fd;
+}
+
+// Clients one at a time, each with tracks of its own, until a stop is requested.
+void ServeSocket(const std::string& path, RecognitionService& service) {
+  const int listener = ListenOn(path);
+  std::cerr << "serve: ready, listening on " << path << '\n';
+  while (!stop_requested) {
+    const int client = accept4(listener, nullptr, nullptr, SOCK_CLOEXEC);
+    if (client < 0) continue;  // EINTR (a stop, checked above) or a client that went before it was accepted
+    service.Reset();
+    ServeClient(client, client, service);
+    close(client);
+  }
+  close(listener);
+  unlink(path.c_str());
+}
+
+int RunServe(const ServeArgs& args) {
+  const RecognizerOptions options = RecognizerOptionsFromArgs(args.recognizer);
+  const LoadedRecognizer loaded = LoadRecognizer(args.recognizer, options, "serve");
+  RecognitionService service(*loaded.recognizer, args.recognizer.stream);
+  InstallStopHandlers();
+  if (!args.socket.empty()) {
+    ServeSocket(args.socket, service);
+  } else {
+    std::cerr << "serve: ready, reading requests on standard input\n";
+    ServeClient(STDIN_FILENO, STDOUT_FILENO, service);
+  }
+  std::cerr << "serve: " << (stop_requested ? "stopped" : "input ended") << '\n';
+  return kExitOk;
+}
+
+}  // namespace
+
+CommandAction SetupServeCommand(CLI::App& command) {
+  auto args = std::make_shared<ServeArgs>();
+  AddRecognizerFlags(command, &args->recognizer);
+  command.add_option("--socket", args->socket,
+                     "Serve a Unix socket at this path, one client at a time, each with tracks of its own (default: "
+                     "standard input and output)");
+  command.footer(
+      "Requests, one JSON object per line: {\"frame\": FRAME} or {\"color\": PATH, \"depth\": PATH, \"depth_scale\": "
+      "S,\n\"camera\": [fx, fy, cx, cy]}, with optional \"id\" (echoed), \"track\": true|false (default: --track) and "
+      "\"reset\": true.\nEach gets one line: the detections as `recognize --out-json` writes them, or {\"id\": ..., "
+      "\"error\": ...}.\nSIGTERM ends the service after the request in hand (exit 0). Protocol: docs/serve.md.");
+  return [args] { return RunServe(*args); };
+}
+
+}  // namespace ecv::app
