@@ -11,9 +11,7 @@ with the date, the machine and the command.
 
 import argparse
 import datetime
-import os
 import pathlib
-import platform
 import statistics
 import sys
 import time
@@ -21,25 +19,9 @@ import time
 import numpy as np
 
 import ecvpose
+from bench_util import frame_prefixes, machine
 
 HERE = pathlib.Path(__file__).resolve().parent
-
-
-def machine():
-    name = platform.processor() or "unknown CPU"
-    try:
-        for line in open("/proc/cpuinfo", encoding="ascii", errors="replace"):
-            if line.startswith("model name"):
-                name = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return f"{name} ({os.cpu_count()} cores)"
-
-
-def frame_prefixes(data):
-    scenes = pathlib.Path(data) / "ycbv_subset" / "Example-Scenes"
-    return sorted(str(p)[: -len("-color.png")] for p in scenes.glob("*/*-color.png"))
 
 
 def timed(recognizer, call):

@@ -66,16 +66,18 @@ void InsertPrimitives(SqlConnection& connection, int64_t view_id, const ModelVie
   }
 }
 
-int64_t InsertModelRow(SqlConnection& connection, const ModelRecord& record) {
+// The model's row; with the id of the model it replaces, so that a model keeps its number (its BOP obj_id).
+int64_t InsertModelRow(SqlConnection& connection, const ModelRecord& record, std::optional<int64_t> id) {
   SqlStatement insert = connection.Prepare(
       "INSERT INTO models (name, mesh_path, mesh_sha256, unit, object_from_mesh, diameter_m, symmetric, "
-      "build_options, num_views, num_primitives, num_descriptors, descriptor_sha256, created) "
-      "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+      "build_options, num_views, num_primitives, num_descriptors, descriptor_sha256, created, id) "
+      "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
   insert.Bind(1, record.name).Bind(2, record.mesh_path).Bind(3, record.mesh_sha256).Bind(4, record.unit);
   insert.Bind(5, PoseText(record.object_from_mesh)).Bind(6, record.diameter_m).Bind(7, record.symmetric ? 1 : 0);
   insert.Bind(8, record.build_options_json.empty() ? std::string("{}") : record.build_options_json);
   insert.Bind(9, static_cast<int>(record.views.size())).Bind(10, record.NumPrimitives());
   insert.Bind(11, record.NumDescriptors()).Bind(12, record.DescriptorSha256()).Bind(13, UtcNow());
+  if (id) insert.Bind(14, *id);  // unbound: NULL, a new number
   insert.Run();
   return connection.LastInsertRowId();
 }
@@ -179,7 +181,8 @@ AddModelResult ModelDatabase::AddModel(const ModelRecord& record, const InsertPr
   SqlTransaction transaction(connection);
   AdoptFeatureSettings(connection, record);
   std::optional<ColorMatrixRecord> kept_matrix;
-  if (const std::optional<int64_t> old_id = ModelId(connection, record.name)) {
+  const std::optional<int64_t> old_id = ModelId(connection, record.name);
+  if (old_id) {
     result.replaced = true;
     const std::optional<ColorMatrixRecord> matrix = ReadColorMatrix(connection, *old_id);
     SqlStatement hash = connection.Prepare("SELECT mesh_sha256 FROM models WHERE id = ?");
@@ -192,7 +195,7 @@ AddModelResult ModelDatabase::AddModel(const ModelRecord& record, const InsertPr
     remove.Bind(1, *old_id);
     remove.Run();
   }
-  const int64_t model_id = InsertModelRow(connection, record);
+  const int64_t model_id = InsertModelRow(connection, record, old_id);
   for (size_t v = 0; v < record.views.size(); ++v) {
     InsertView(connection, model_id, record.views[v]);
     if (progress) progress(static_cast<int>(v + 1), static_cast<int>(record.views.size()));

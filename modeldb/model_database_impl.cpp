@@ -171,6 +171,7 @@ ModelSummary ReadSummary(const SqlStatement& row, const std::string& path) {
   summary.created = row.Text(12);
   summary.has_color_matrix = row.Int(13) != 0;
   summary.mesh_blob_bytes = row.Int(14);
+  summary.id = row.Int(15);
   return summary;
 }
 

@@ -80,6 +80,7 @@ ModelRecord ReadModel(SqlConnection& connection, const std::string& name, const 
   select.Step();
   const ModelSummary summary = ReadSummary(select, connection.path());
   ModelRecord record;
+  record.id = summary.id;
   record.name = summary.name;
   record.mesh_path = summary.mesh_path;
   record.mesh_sha256 = summary.mesh_sha256;

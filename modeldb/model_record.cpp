@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "io/frame_io.h"
 #include "io/mesh_blob.h"
 #include "io/mesh_io.h"
 #include "modeldb/content_hash.h"
@@ -93,6 +94,17 @@ FeatureSettings FeatureSettingsFromJson(const std::string& text, const std::stri
     Read(group == "ecv" ? ecv : descriptor, key, &field, source);
   });
   return settings;
+}
+
+int BopObjectId(const std::string& name, int64_t library_id) {
+  if (name.size() > 4 && name.size() <= 13 && name.rfind("obj_", 0) == 0 &&
+      name.find_first_not_of("0123456789", 4) == std::string::npos) {
+    return std::stoi(name.substr(4));
+  }
+  for (int id = 1; id <= 21; ++id) {
+    if (YcbvClassName(id) == name) return id;
+  }
+  return static_cast<int>(library_id);
 }
 
 int ModelRecord::NumPrimitives() const {

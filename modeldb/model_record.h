@@ -44,6 +44,7 @@ struct ModelView {
 
 /// A whole library model: where it came from, how it was built, and its views.
 struct ModelRecord {
+  int64_t id = 0;           ///< the model's number in its library (0: not stored yet), kept when it is built again
   std::string name;         ///< unique in a library
   std::string mesh_path;    ///< the mesh file it was built from
   std::string mesh_sha256;  ///< SHA-256 of the mesh file followed by its texture files
@@ -66,6 +67,10 @@ struct ModelRecord {
   /// the descriptors are equal bit for bit.
   std::string DescriptorSha256() const;
 };
+
+/// The BOP obj_id of a model: the number of a BOP name ("obj_000005": 5), the class index of a YCB-Video name
+/// ("003_cracker_box": 2), else its number in the library (`library_id`).
+int BopObjectId(const std::string& name, int64_t library_id);
 
 /// The mesh of a library model in the object frame (metres): the stored one (mesh_blob) when there is one, else
 /// its mesh file (mesh_path with the record's unit and object_from_mesh; missing textures tolerated, as in the
@@ -91,6 +96,7 @@ struct StoredModel {
 
 /// What the database says about one model, without its views.
 struct ModelSummary {
+  int64_t id = 0;  ///< the model's number in its library, kept when the model is built again
   std::string name;
   std::string mesh_path;
   std::string mesh_sha256;

@@ -170,6 +170,8 @@ int RunBuild(const ModeldbArgs& args) {
 
 nlohmann::ordered_json SummaryJson(const ModelSummary& m) {
   return {{"name", m.name},
+          {"id", m.id},
+          {"bop_obj_id", BopObjectId(m.name, m.id)},
           {"mesh_path", m.mesh_path},
           {"mesh_sha256", m.mesh_sha256},
           {"unit", m.unit},
@@ -197,13 +199,13 @@ int RunList(const ModeldbArgs& args) {
   }
   std::printf("%s: %zu models (schema version %d)\n", args.db.c_str(), models.size(), kModelDbSchemaVersion);
   if (models.empty()) return kExitOk;
-  std::printf("%-28s %6s %11s %12s %12s %9s %7s %8s  %s\n", "name", "views", "primitives", "descriptors", "diameter_mm",
-              "symmetric", "colour", "mesh_MB", "created");
+  std::printf("%-28s %6s %6s %11s %12s %12s %9s %7s %8s  %s\n", "name", "obj_id", "views", "primitives", "descriptors",
+              "diameter_mm", "symmetric", "colour", "mesh_MB", "created");
   for (const ModelSummary& m : models) {
     const std::string mesh = m.mesh_blob_bytes > 0 ? Fixed(m.mesh_blob_bytes / 1e6, 1) : "file";  // not stored
-    std::printf("%-28s %6d %11d %12d %12.1f %9s %7s %8s  %s\n", m.name.c_str(), m.num_views, m.num_primitives,
-                m.num_descriptors, 1000.0 * m.diameter_m, m.symmetric ? "yes" : "no", m.has_color_matrix ? "yes" : "no",
-                mesh.c_str(), m.created.c_str());
+    std::printf("%-28s %6d %6d %11d %12d %12.1f %9s %7s %8s  %s\n", m.name.c_str(), BopObjectId(m.name, m.id),
+                m.num_views, m.num_primitives, m.num_descriptors, 1000.0 * m.diameter_m, m.symmetric ? "yes" : "no",
+                m.has_color_matrix ? "yes" : "no", mesh.c_str(), m.created.c_str());
   }
   return kExitOk;
 }

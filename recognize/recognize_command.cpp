@@ -6,6 +6,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -23,6 +24,7 @@
 #include "recognize/recognition_stream.h"
 #include "recognize/recognize_flags.h"
 #include "recognize/recognizer.h"
+#include "recognize/sequence_io.h"
 
 namespace ecv::app {
 namespace {
@@ -31,71 +33,67 @@ struct RecognizeArgs {
   RecognizerArgs recognizer;  // --db, --models, the search, tracking and verification flags
   FrameSpec frame;
   std::string sequence;
+  bool follow = false;
+  double idle_timeout_s = 10.0;
   std::string out_json;
   std::string out_bop;
   int scene_id = -1, image_id = -1;
   std::string overlay;
 };
 
-// BOP object id of a model: the number in "obj_000005", or the YCB-Video class index of "003_cracker_box".
-int BopObjectId(const std::string& model) {
-  if (model.rfind("obj_", 0) == 0) return std::stoi(model.substr(4));
-  for (int id = 1; id <= 21; ++id) {
-    if (YcbvClassName(id) == model) return id;
+// The BOP obj_id of each model of the library (modeldb list shows them).
+std::map<std::string, int> BopObjectIds(const ModelLibrary& library) {
+  std::map<std::string, int> ids;
+  for (const LibraryModel& model : library.models()) {
+    ids[model.record.name] = BopObjectId(model.record.name, model.record.id);
   }
-  ThrowInputError(model, "model name", "obj_NNNNNN or a YCB-Video class name, for the BOP obj_id");
+  return ids;
 }
 
-// Scene and image ids of a frame: from the flags, or from a YCB-Video prefix ".../0001/000007" or a BOP
-// image "SCENE_DIR:ID".
-std::pair<int, int> BopIds(const std::string& frame, int scene_id, int image_id) {
-  namespace fs = std::filesystem;
-  if (scene_id >= 0 && image_id >= 0) return {scene_id, image_id};
-  const size_t colon = frame.rfind(':');
-  try {
-    if (colon != std::string::npos) {
-      return {std::stoi(fs::path(frame.substr(0, colon)).filename().string()), std::stoi(frame.substr(colon + 1))};
-    }
-    return {std::stoi(fs::path(frame).parent_path().filename().string()),
-            std::stoi(fs::path(frame).filename().string())};
-  } catch (const std::exception&) {
-    ThrowInputError(frame, "scene and image ids", "--scene-id and --image-id, or a YCB-Video or BOP frame name");
-  }
+// Scene and image ids of a frame: from --scene-id and --image-id (a single frame), else as the frame names them (a
+// YCB-Video prefix, a BOP image, a frame JSON's keys), else scene 0 and the frame's place in the sequence from 0.
+std::pair<int, int> BopIds(const LoadedFrame& frame, int index, int scene_flag = -1, int image_flag = -1) {
+  if (scene_flag >= 0 && image_flag >= 0) return {scene_flag, image_flag};
+  if (frame.scene_id >= 0 && frame.image_id >= 0) return {frame.scene_id, frame.image_id};
+  return {0, index};
 }
+
+constexpr const char* kBopHeader = "scene_id,im_id,obj_id,score,R,t,time\n";
 
 // One BOP CSV row per detection: scene_id,im_id,obj_id,score,R (9, row-major),t (mm),time (s).
-void AppendBopRows(std::ostream& out, int scene_id, int image_id, const RecognitionResult& result) {
+void AppendBopRows(std::ostream& out, std::pair<int, int> ids, const RecognitionResult& result,
+                   const std::map<std::string, int>& object_ids) {
   for (const Detection& d : result.detections) {
     const Eigen::Matrix3d r = d.camera_from_object.linear();
     const Eigen::Vector3d t = d.camera_from_object.translation() * 1000.0;
-    out << scene_id << ',' << image_id << ',' << BopObjectId(d.model) << ',' << d.score << ',';
+    out << ids.first << ',' << ids.second << ',' << object_ids.at(d.model) << ',' << d.score << ',';
     for (int i = 0; i < 9; ++i) out << (i > 0 ? " " : "") << r(i / 3, i % 3);
     out << ',' << t.x() << ' ' << t.y() << ' ' << t.z() << ',' << result.timings_ms.at("total") / 1000.0 << '\n';
   }
 }
 
-void PrintDetections(const LoadedFrame& loaded, const RecognitionResult& result) {
-  std::cout << std::fixed << std::setprecision(2) << loaded.rgbd.name << ": " << result.detections.size()
-            << " detections (" << result.scene_primitives << " scene primitives)\n";
+void PrintDetections(std::ostream& out, const LoadedFrame& loaded, const RecognitionResult& result) {
+  out << std::fixed << std::setprecision(2) << loaded.rgbd.name << ": " << result.detections.size() << " detections ("
+      << result.scene_primitives << " scene primitives)\n";
   for (const Detection& d : result.detections) {
-    std::cout << "  " << std::left << std::setw(24) << d.model << std::right << " score " << d.score << " (depth "
-              << d.depth_agreement << ", colour " << d.color_agreement << ", edges " << d.edge_agreement << " of "
-              << d.edge_pixels << ", fit " << std::setprecision(1) << 1000.0 * d.surface_error_m << " mm"
-              << std::setprecision(2) << ", outline " << d.contour_agreement << "), inliers " << d.inlier_fraction
-              << ", view " << d.view << ", " << HypothesisSourceName(d.hypothesis) << (d.tracked ? ", tracked" : "")
-              << ", t = [" << std::setprecision(3) << d.camera_from_object.translation().transpose() << "] m"
-              << std::setprecision(2) << '\n';
+    out << "  " << std::left << std::setw(24) << d.model << std::right << " score " << d.score << " (depth "
+        << d.depth_agreement << ", colour " << d.color_agreement << ", edges " << d.edge_agreement << " of "
+        << d.edge_pixels << ", fit " << std::setprecision(1) << 1000.0 * d.surface_error_m << " mm"
+        << std::setprecision(2) << ", outline " << d.contour_agreement << "), inliers " << d.inlier_fraction
+        << ", view " << d.view << ", " << HypothesisSourceName(d.hypothesis) << (d.tracked ? ", tracked" : "")
+        << ", t = [" << std::setprecision(3) << d.camera_from_object.translation().transpose() << "] m"
+        << std::setprecision(2) << '\n';
     for (const GroundTruth& truth : loaded.ground_truth) {
       if (truth.object_name != d.model) continue;
-      std::cout << "    vs ground truth: " << std::setprecision(1)
-                << TranslationDistance(d.camera_from_object, truth.camera_from_object) * 1000.0 << " mm, "
-                << RotationAngle(d.camera_from_object, truth.camera_from_object) * 180.0 / M_PI << " deg\n"
-                << std::setprecision(2);
+      out << "    vs ground truth: " << std::setprecision(1)
+          << TranslationDistance(d.camera_from_object, truth.camera_from_object) * 1000.0 << " mm, "
+          << RotationAngle(d.camera_from_object, truth.camera_from_object) * 180.0 / M_PI << " deg\n"
+          << std::setprecision(2);
     }
   }
-  std::cout << "time:" << std::setprecision(1);
-  for (const auto& [stage, ms] : result.timings_ms) std::cout << ' ' << stage << ' ' << ms << " ms";
-  std::cout << '\n';
+  out << "time:" << std::setprecision(1);
+  for (const auto& [stage, ms] : result.timings_ms) out << ' ' << stage << ' ' << ms << " ms";
+  out << '\n';
 }
 
 // The recognizer's options from the flags, checked.
@@ -113,75 +111,99 @@ RecognizerOptions OptionsFromArgs(const RecognizeArgs& args) {
   return options;
 }
 
-int RecognizeOneFrame(const RecognizeArgs& args, const LoadedFrame& loaded, Recognizer& recognizer) {
+// The human-readable report: on standard output, unless the detections go there ("-").
+std::ostream& Report(const RecognizeArgs& args) {
+  return args.out_json == "-" || args.out_bop == "-" ? std::cerr : std::cout;
+}
+
+int RecognizeOneFrame(const RecognizeArgs& args, const LoadedFrame& loaded, const ModelLibrary& library,
+                      Recognizer& recognizer) {
   const RecognitionResult result = recognizer.Recognize(loaded.rgbd);
-  PrintDetections(loaded, result);
-  if (!args.out_json.empty()) WriteJsonFile(args.out_json, RecognitionToJson(result));
+  PrintDetections(Report(args), loaded, result);
+  const std::string json = RecognitionToJson(result).dump(2) + "\n";
+  if (args.out_json == "-") LineOutput("-", "--out-json").Write(json);
+  if (!args.out_json.empty() && args.out_json != "-") WriteFileAtomically(args.out_json, json);
   if (!args.out_bop.empty()) {
-    const auto [scene_id, image_id] = BopIds(args.frame.positional, args.scene_id, args.image_id);
     std::ostringstream csv;
-    csv << "scene_id,im_id,obj_id,score,R,t,time\n";
-    AppendBopRows(csv, scene_id, image_id, result);
-    WriteFileAtomically(args.out_bop, csv.str());
+    csv << kBopHeader;
+    AppendBopRows(csv, BopIds(loaded, 0, args.scene_id, args.image_id), result, BopObjectIds(library));
+    if (args.out_bop == "-") {
+      LineOutput("-", "--out-bop").Write(csv.str());
+    } else {
+      WriteFileAtomically(args.out_bop, csv.str());
+    }
   }
   if (!args.overlay.empty()) WriteColorImage(args.overlay, recognizer.DrawDetections(loaded.rgbd, result.detections));
   return kExitOk;
 }
 
-// A sequence, processed in order as a camera stream would arrive; a broken frame is reported and skipped.
-int RecognizeSequence(const RecognizeArgs& args, const std::vector<std::string>& frames, Recognizer& recognizer) {
-  std::ostringstream lines, csv;
-  csv << "scene_id,im_id,obj_id,score,R,t,time\n";
-  int failed = 0;
+// A sequence, processed in order as a camera stream would arrive; a broken frame is reported and skipped. Each
+// frame's JSON line and BOP rows are written as soon as it is done.
+int RecognizeSequence(const RecognizeArgs& args, FrameFeed& feed, const ModelLibrary& library, Recognizer& recognizer) {
+  std::ostream& report = Report(args);
+  LineOutput lines(args.out_json, "--out-json"), csv(args.out_bop, "--out-bop");
+  if (csv.active()) csv.Write(kBopHeader);
+  const std::map<std::string, int> object_ids = BopObjectIds(library);
+  int done = 0, failed = 0;
   double total_ms = 0.0;
   RecognitionStream stream(recognizer, args.recognizer.stream);
   if (!args.overlay.empty()) std::filesystem::create_directories(args.overlay);
-  for (size_t i = 0; i < frames.size(); ++i) {
+  while (const std::optional<std::string> frame = feed.Next()) {
     FrameSpec spec;
-    spec.positional = frames[i];
+    spec.positional = *frame;
     try {
       const LoadedFrame loaded = app::LoadFrameWithWarnings(spec);
-      const std::pair<int, int> ids = args.out_bop.empty() ? std::pair{-1, -1} : BopIds(frames[i], -1, -1);
       const RecognitionResult result = stream.Next(loaded.rgbd);
       total_ms += result.timings_ms.at("total");
-      std::cout << "[" << i + 1 << "/" << frames.size() << "] ";
-      PrintDetections(loaded, result);
+      report << feed.Counter();
+      PrintDetections(report, loaded, result);
       nlohmann::json line = RecognitionToJson(result);
-      line["frame"] = frames[i];
-      lines << line.dump() << '\n';
-      if (!args.out_bop.empty()) AppendBopRows(csv, ids.first, ids.second, result);
+      line["frame"] = *frame;
+      if (lines.active()) lines.Write(line.dump() + "\n");
+      if (csv.active()) {
+        std::ostringstream rows;
+        AppendBopRows(rows, BopIds(loaded, done + failed), result, object_ids);
+        csv.Write(rows.str());
+      }
+      ++done;
       if (!args.overlay.empty()) {
         char name[32];
-        std::snprintf(name, sizeof(name), "/%04zu.png", i + 1);
+        std::snprintf(name, sizeof(name), "/%04d.png", done + failed);
         WriteColorImage(args.overlay + name, recognizer.DrawDetections(loaded.rgbd, result.detections));
       }
     } catch (const InputError& error) {
       ++failed;
       stream.Reset();  // the priors are lost: the next frame searches every model
-      std::cerr << "recognize: frame " << frames[i] << " skipped: " << error.what() << '\n';
-      lines << nlohmann::json{{"frame", frames[i]}, {"error", error.what()}}.dump() << '\n';
+      std::cerr << "recognize: frame " << *frame << " skipped: " << error.what() << '\n';
+      if (lines.active()) lines.Write(nlohmann::json{{"frame", *frame}, {"error", error.what()}}.dump() + "\n");
     }
   }
-  const size_t done = frames.size() - static_cast<size_t>(failed);
-  std::cout << std::setprecision(2) << done << " frames in " << total_ms / 1000.0 << " s ("
-            << (total_ms > 0.0 ? 1000.0 * static_cast<double>(done) / total_ms : 0.0) << " frames per second)";
-  if (failed > 0) std::cout << ", " << failed << " failed";
-  std::cout << '\n';
-  if (!args.out_json.empty()) WriteFileAtomically(args.out_json, lines.str());
-  if (!args.out_bop.empty()) WriteFileAtomically(args.out_bop, csv.str());
+  report << std::setprecision(2) << done << " frames in " << total_ms / 1000.0 << " s ("
+         << (total_ms > 0.0 ? 1000.0 * done / total_ms : 0.0) << " frames per second)";
+  if (failed > 0) report << ", " << failed << " failed";
+  report << '\n';
   return failed > 0 ? kExitBadInput : kExitOk;
 }
 
 int RunRecognize(const RecognizeArgs& args) {
+  if (args.out_json == "-" && args.out_bop == "-") {
+    std::cerr << "ecvpose recognize: --out-json and --out-bop cannot both be standard output (-)\n";
+    return kExitBadUsage;
+  }
+  if (args.follow && args.sequence.empty()) {
+    std::cerr << "ecvpose recognize: --follow needs --sequence FOLDER\n";
+    return kExitBadUsage;
+  }
   const RecognizerOptions options = OptionsFromArgs(args);
-  std::vector<std::string> frames;
-  if (!args.sequence.empty()) frames = ListSequenceFrames(args.sequence);
+  std::optional<FrameFeed> feed;
+  if (!args.sequence.empty()) feed.emplace(args.sequence, args.follow, args.idle_timeout_s);
   // One frame is read first: a broken one is reported before the library and its meshes (seconds) are loaded.
   std::optional<LoadedFrame> single;
-  if (frames.empty()) single.emplace(app::LoadFrameWithWarnings(args.frame));
+  if (!feed) single.emplace(app::LoadFrameWithWarnings(args.frame));
   const LoadedRecognizer loaded = LoadRecognizer(args.recognizer, options, "recognize");
   Recognizer& recognizer = *loaded.recognizer;
-  return single ? RecognizeOneFrame(args, *single, recognizer) : RecognizeSequence(args, frames, recognizer);
+  return single ? RecognizeOneFrame(args, *single, *loaded.library, recognizer)
+                : RecognizeSequence(args, *feed, *loaded.library, recognizer);
 }
 
 }  // namespace
@@ -196,13 +218,23 @@ CommandAction SetupRecognizeCommand(CLI::App& command) {
       "--sequence", args->sequence,
       "Frames in order: a BOP scene folder, a YCB-Video video folder, a directory of frame JSONs, or a file with\n"
       "one FRAME per line");
-  command.add_option(
-      "--out-json", args->out_json,
-      "Detections as JSON (model, score, camera_from_object and the verification terms); JSON Lines for a sequence");
+  command.add_flag("--follow", args->follow,
+                   "With --sequence FOLDER: also take the frame JSONs that appear in the folder while it runs (write\n"
+                   "the images first, the JSON last, by rename), until --idle-timeout passes without a new one");
+  command.add_option("--idle-timeout", args->idle_timeout_s, "With --follow: seconds to wait for a new frame")
+      ->capture_default_str()
+      ->check(NonNegative());
+  command.add_option("--out-json", args->out_json,
+                     "Detections as JSON (model, score, camera_from_object and the verification terms); for a\n"
+                     "sequence JSON Lines, each frame's line written as soon as it is done; - for standard output");
   command.add_option("--out-bop", args->out_bop,
-                     "Detections as BOP CSV (scene_id,im_id,obj_id,score,R,t,time; t in mm)");
-  command.add_option("--scene-id", args->scene_id, "BOP scene id (default: from the frame name)");
-  command.add_option("--image-id", args->image_id, "BOP image id (default: from the frame name)");
+                     "Detections as BOP CSV (scene_id,im_id,obj_id,score,R,t,time; t in mm), rows written as each\n"
+                     "frame is done; - for standard output");
+  command.add_option("--scene-id", args->scene_id,
+                     "BOP scene id of a single frame (default: as the frame names it, else 0)");
+  command.add_option("--image-id", args->image_id,
+                     "BOP image id of a single frame (default: as the frame names it, else its place in the\n"
+                     "sequence from 0)");
   command.add_option("--overlay", args->overlay,
                      "Picture: each detected model in red with its name (PNG); with --sequence a directory,\n"
                      "one DIR/0001.png ... per frame in sequence order");

@@ -121,6 +121,10 @@ LoadedFrame LoadBopFrame(const std::string& scene_dir, int image_id, const std::
   loaded.rgbd = MakeFrame(color_path, depth_path, 1000.0 / depth_scale_mm, {k[0], k[4], k[2], k[5]},
                           scene_dir + ":" + std::to_string(image_id));
   loaded.ground_truth = ReadBopGroundTruth(scene_dir, image_id);
+  fs::path folder = fs::path(scene_dir).lexically_normal();
+  if (folder.filename().empty()) folder = folder.parent_path();  // "…/000002/"
+  loaded.scene_id = std::max(0, NumberOfName(folder.filename().string()));
+  loaded.image_id = image_id;
   return loaded;
 }
 

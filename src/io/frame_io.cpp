@@ -297,6 +297,11 @@ RgbdFrame MakeFrame(const std::string& color_path, const std::string& depth_path
   return frame;
 }
 
+int NumberOfName(const std::string& name) {
+  if (name.empty() || name.size() > 9 || name.find_first_not_of("0123456789") != std::string::npos) return -1;
+  return std::stoi(name);
+}
+
 LoadedFrame LoadFrameJson(const std::string& path) {
   const nlohmann::json json = ReadJsonFile(path);
   const fs::path base = fs::path(path).parent_path();
@@ -320,6 +325,16 @@ LoadedFrame LoadFrameJson(const std::string& path) {
   LoadedFrame loaded;
   loaded.rgbd =
       MakeFrame(string_field("color"), string_field("depth"), json["depth_scale"].get<double>(), intrinsics, path);
+  for (auto [key, id] : {std::pair{"scene_id", &loaded.scene_id}, std::pair{"image_id", &loaded.image_id}}) {
+    if (!json.contains(key)) continue;
+    if (!json[key].is_number_integer() || json[key].get<int64_t>() < 0 || json[key].get<int64_t>() > 999999999) {
+      ThrowInputError(path, key, "a whole number >= 0 (the BOP id)", json[key].dump());
+    }
+    *id = json[key].get<int>();
+  }
+  if (loaded.image_id >= 0 && loaded.scene_id < 0) loaded.scene_id = 0;
+  if (loaded.scene_id >= 0 && loaded.image_id < 0)
+    ThrowInputError(path, "image_id", "a whole number >= 0 beside scene_id");
   return loaded;
 }
 

@@ -26,7 +26,14 @@ struct FrameSpec {
 struct LoadedFrame {
   RgbdFrame rgbd;
   std::vector<GroundTruth> ground_truth;
+  /// BOP scene and image ids where the source names them (a YCB-Video prefix .../0001/000007: 1 and 7; a BOP image:
+  /// its scene folder's number and its id; a frame JSON: its "scene_id" and "image_id"); -1 otherwise.
+  int scene_id = -1;
+  int image_id = -1;
 };
+
+/// The number a file or folder name spells ("000007": 7); -1 unless it is 1 to 9 decimal digits.
+int NumberOfName(const std::string& name);
 
 /// Loads the frame named by `spec`. Throws InputError naming the file and field on any broken input. Adds to
 /// `warnings` what is readable but suspect (DepthRangeWarning).

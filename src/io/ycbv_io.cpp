@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <filesystem>
 #include <memory>
 #include <vector>
 
@@ -119,6 +120,10 @@ LoadedFrame LoadYcbvFrame(const std::string& prefix) {
   LoadedFrame loaded;
   loaded.rgbd =
       MakeFrame(prefix + "-color.png", prefix + "-depth.png", factor.values[0], {k[0], k[4], k[6], k[7]}, prefix);
+  const std::filesystem::path name(prefix);
+  loaded.scene_id = NumberOfName(name.parent_path().filename().string());
+  loaded.image_id = loaded.scene_id >= 0 ? NumberOfName(name.filename().string()) : -1;
+  if (loaded.image_id < 0) loaded.scene_id = -1;
   for (size_t n = 0; n < num_objects; ++n) {
     Eigen::Matrix4d matrix = Eigen::Matrix4d::Identity();
     for (int r = 0; r < 3; ++r) {

@@ -86,6 +86,32 @@ TEST(ModelDatabase, ReplacesAModelOfTheSameNameWhole) {
   EXPECT_EQ(report.primitives, 5 * 80 + 2 * 100);
 }
 
+// A model's number in the library is its BOP obj_id unless its name gives one: it stays when the model is built
+// again, and the loaded record carries it.
+TEST(ModelDatabase, AModelKeepsItsNumberWhenBuiltAgain) {
+  ModelDatabase database(":memory:", OpenMode::kCreate);
+  database.AddModel(test::SyntheticModel("a", 2, 50, 1));
+  database.AddModel(test::SyntheticModel("b", 2, 50, 2));
+  const int64_t a = database.FindModel("a")->id, b = database.FindModel("b")->id;
+  EXPECT_NE(a, b);
+  EXPECT_GT(a, 0);
+  database.AddModel(test::SyntheticModel("a", 3, 40, 3));
+  database.AddModel(test::SyntheticModel("c", 2, 50, 4));
+  EXPECT_EQ(database.FindModel("a")->id, a);
+  EXPECT_NE(database.FindModel("c")->id, a);
+  EXPECT_NE(database.FindModel("c")->id, b);
+  EXPECT_EQ(database.LoadModels({"a"}).at(0).record.id, a);
+}
+
+TEST(BopObjectId, FromABopOrYcbVideoNameElseTheLibraryNumber) {
+  EXPECT_EQ(BopObjectId("obj_000005", 9), 5);
+  EXPECT_EQ(BopObjectId("003_cracker_box", 9), 2);
+  EXPECT_EQ(BopObjectId("021_bleach_cleanser", 9), 12);
+  EXPECT_EQ(BopObjectId("mug", 9), 9);
+  EXPECT_EQ(BopObjectId("obj_12x", 9), 9);
+  EXPECT_EQ(BopObjectId("obj_", 9), 9);
+}
+
 TEST(ModelDatabase, RemovesAModelWithItsRows) {
   ModelDatabase database(":memory:", OpenMode::kCreate);
   database.AddModel(test::SyntheticModel("a", 3, 100, 1));

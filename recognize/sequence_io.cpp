@@ -1,0 +1,84 @@
+#include "recognize/sequence_io.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstring>
+#include <filesystem>
+#include <thread>
+
+#include "core/error.h"
+#include "io/frame_io.h"
+#include "io/paths.h"
+
+namespace ecv::app {
+namespace fs = std::filesystem;
+
+LineOutput::LineOutput(const std::string& path, const std::string& flag) : path_(path) {
+  if (path.empty()) return;
+  if (path == "-") {
+    fd_ = STDOUT_FILENO;
+    return;
+  }
+  fd_ = open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd_ < 0) ThrowInputError(path, flag, "a file that can be written", std::strerror(errno));
+  owned_ = true;
+}
+
+LineOutput::~LineOutput() {
+  if (owned_) close(fd_);
+}
+
+void LineOutput::Write(const std::string& text) {
+  size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t wrote = write(fd_, text.data() + done, text.size() - done);
+    if (wrote < 0 && errno == EINTR) continue;
+    if (wrote <= 0)
+      ThrowInputError(path_ == "-" ? "standard output" : path_, "output", "room to write", std::strerror(errno));
+    done += static_cast<size_t>(wrote);
+  }
+}
+
+FrameFeed::FrameFeed(const std::string& sequence, bool follow, double idle_timeout_s)
+    : folder_(sequence), follow_(follow), idle_timeout_(idle_timeout_s) {
+  if (!follow) {
+    frames_ = ListSequenceFrames(sequence);
+    return;
+  }
+  if (!IsDirectory(sequence)) {
+    ThrowInputError(sequence, "--follow", "a folder that frame JSONs are written into", "no such folder");
+  }
+  Scan();
+}
+
+void FrameFeed::Scan() {
+  std::error_code error;
+  std::vector<std::string> found;
+  for (fs::directory_iterator entry(folder_, error), end; !error && entry != end; entry.increment(error)) {
+    const fs::path& path = entry->path();
+    if (path.extension() == ".json" && seen_.insert(path.string()).second) found.push_back(path.string());
+  }
+  std::sort(found.begin(), found.end());
+  frames_.insert(frames_.end(), found.begin(), found.end());
+}
+
+std::optional<std::string> FrameFeed::Next() {
+  if (follow_ && next_ == frames_.size()) {
+    const auto since = std::chrono::steady_clock::now();
+    while (next_ == frames_.size() && std::chrono::steady_clock::now() - since < idle_timeout_) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      Scan();
+    }
+  }
+  if (next_ == frames_.size()) return std::nullopt;
+  return frames_[next_++];
+}
+
+std::string FrameFeed::Counter() const {
+  return "[" + std::to_string(next_) + (follow_ ? "" : "/" + std::to_string(frames_.size())) + "] ";
+}
+
+}  // namespace ecv::app

@@ -1,0 +1,60 @@
+#pragma once
+
+// The input and output of `ecvpose recognize --sequence` as a stream: frames as they come (a folder still being
+// filled), detections written as each frame is done.
+
+#include <chrono>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace ecv::app {
+
+/// Where results go line by line: a file, truncated when opened, or standard output for "-". Each Write reaches the
+/// file in one system call, at once (no buffering), so that a reader following the file sees each line whole as
+/// soon as it is written.
+class LineOutput {
+ public:
+  /// No output for an empty `path`. Throws InputError naming `path` (and `flag`) when it cannot be opened.
+  LineOutput(const std::string& path, const std::string& flag);
+  ~LineOutput();
+  LineOutput(const LineOutput&) = delete;
+  LineOutput& operator=(const LineOutput&) = delete;
+
+  bool active() const { return fd_ >= 0; }
+
+  /// Appends `text` (whole lines); throws InputError naming the file when it cannot.
+  void Write(const std::string& text);
+
+ private:
+  std::string path_;
+  int fd_ = -1;
+  bool owned_ = false;
+};
+
+/// The frames of --sequence, in order. With `follow`, the frame JSONs of a folder still being filled, in name order
+/// as they appear (a producer writes the images first and the JSON last, by rename), until `idle_timeout_s` pass
+/// without a new one.
+class FrameFeed {
+ public:
+  FrameFeed(const std::string& sequence, bool follow, double idle_timeout_s);
+
+  /// The next frame; nothing at the end.
+  std::optional<std::string> Next();
+
+  /// "[3/10] " for a list of known length, "[3] " when following.
+  std::string Counter() const;
+
+ private:
+  void Scan();  // adds the folder's frame JSONs not seen yet, in name order
+
+  std::string folder_;
+  bool follow_;
+  std::chrono::duration<double> idle_timeout_;
+  std::vector<std::string> frames_;
+  size_t next_ = 0;
+  std::set<std::string> seen_;
+};
+
+}  // namespace ecv::app
