@@ -10,7 +10,6 @@ with the date, the machine and the command.
 """
 
 import argparse
-import datetime
 import pathlib
 import statistics
 import sys
@@ -19,7 +18,7 @@ import time
 import numpy as np
 
 import ecvpose
-from bench_util import frame_prefixes, machine
+from bench_util import frame_prefixes, report
 
 HERE = pathlib.Path(__file__).resolve().parent
 
@@ -69,13 +68,7 @@ def main():
              f"recognizer's own total for it; median recognition wall time {statistics.median(walls):.0f} ms per "
              "frame.", "", "| call | median overhead ms | 90th percentile ms | max ms |", "|---|---:|---:|---:|"]
     lines += [row(name, values) for name, values in overheads.items()]
-    markdown = "\n".join(lines) + "\n"
-    print(markdown)
-    stamp = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
-    command = " ".join(["bench/python_bench.py"] + sys.argv[1:])
-    with open(args.results, "a", encoding="utf-8") as results:
-        results.write(f"\n## Python module overhead (python_bench.py)\n\n{stamp}, {machine()}, `{command}`\n\n"
-                      f"{markdown}\n")
+    report(args.results, "Python module overhead (python_bench.py)", lines)
     return 0
 
 

@@ -10,7 +10,6 @@ markdown table and appends it to bench/RESULTS.md with the date, the machine and
 """
 
 import argparse
-import datetime
 import json
 import os
 import pathlib
@@ -22,7 +21,7 @@ import time
 
 HERE = pathlib.Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
-from bench_util import frame_prefixes, machine  # noqa: E402
+from bench_util import frame_prefixes, report  # noqa: E402
 
 
 def one_shot(cli, db, frame, out):
@@ -69,13 +68,7 @@ def main():
              f"{sum(shot_times) / 1000:.1f} |",
              f"| one `serve` process | {serve_times[0]:.0f} | {statistics.median(serve_times[1:]):.0f} | "
              f"{sum(serve_times) / 1000:.1f} |"]
-    markdown = "\n".join(lines) + "\n"
-    print(markdown)
-    stamp = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
-    command = " ".join(["bench/serve_bench.py"] + sys.argv[1:])
-    with open(args.results, "a", encoding="utf-8") as results:
-        results.write(f"\n## serve against one-shot recognize (serve_bench.py)\n\n{stamp}, {machine()}, `{command}`"
-                      f"\n\n{markdown}\n")
+    report(args.results, "serve against one-shot recognize (serve_bench.py)", lines)
     return 0 if same == len(frames) else 1
 
 
