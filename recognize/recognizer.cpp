@@ -16,6 +16,7 @@
 #include "recognize/detection_overlay.h"
 #include "recognize/model_search.h"
 #include "recognize/scene.h"
+#include "recognize/tracking.h"
 #include "recognize/verification.h"
 #include "registration/ppf.h"
 #include "render/renderer.h"
@@ -23,18 +24,6 @@
 
 namespace ecv {
 namespace {
-
-// One model in one frame: the priors to follow, the instances found so far (tracked, then searched) and the scene
-// pixels their surfaces cover, and whether it is still to be searched by view ranking and RANSAC.
-struct ModelInFrame {
-  std::vector<const Detection*> priors;
-  std::vector<Verified> instances;
-  cv::Mat covered;
-  bool lost = false;  // seen before: a prior failed or scored too low to follow
-  bool search = false;
-  // Tracked instances due for confirmation, set aside while their model is searched as if it had no priors.
-  std::vector<Verified> to_confirm;
-};
 
 // What searching a model found besides its instances.
 struct ModelSearchResult {
@@ -78,6 +67,7 @@ class Recognizer::Impl {
       for (const TriangleMesh& mesh : meshes) meshes_.push_back(renderer_.AddMesh(mesh));
     }
     for (size_t m = 0; m < models.size(); ++m) {
+      model_names_.push_back(models[m].record.name);
       RenderOptions& render = render_options_.emplace_back();
       render.shading = StoredViewShading(models[m].record.build_options_json);
       render.cull_back_faces = options_.verify.cull_back_faces && closed[m] != 0;
@@ -115,13 +105,13 @@ class Recognizer::Impl {
     RecognitionResult result;
     StageTimes times;
     Scene scene = PrepareScene(frame, options_);
-    std::vector<ModelInFrame> models = AssignPriors(priors);
+    std::vector<ModelInFrame> models = AssignPriors(priors, model_names_, options_.tracking);
     if (!priors.empty()) {
       const Clock::time_point stage = Clock::now();
       FollowPriors(scene, &models);
       times.Add(Stage::kTrack, MillisecondsSince(stage));
     }
-    const int searched = ChooseModels(scope, &models);
+    const int searched = ChooseModels(scope, options_.tracking, options_.max_instances, &models);
     const bool context = options_.point_pairs.source != HypothesisSource::kPpf;
     if (context && searched > 0) {  // none when all are tracked
       DescribeScene(library_.feature_settings(), options_, &scene, &times);
@@ -146,7 +136,8 @@ class Recognizer::Impl {
     if (options_.point_pairs.source != HypothesisSource::kContext) SearchByPointPairs(scene, &models, &times);
     std::vector<Verified> candidates;
     for (size_t m = 0; m < models.size(); ++m) {
-      MergeConfirmation(frame.depth.size(), &models[m]);
+      MergeConfirmation(frame.depth.size(), options_.max_overlap, options_.max_instances, options_.dense_stride_px,
+                        &models[m]);
       times += searches[m].times;
       if (searches[m].views_tried >= 0) result.views_tried[records_[m].name] = searches[m].views_tried;
       for (Verified& verified : models[m].instances) candidates.push_back(std::move(verified));
@@ -172,13 +163,6 @@ class Recognizer::Impl {
   }
 
  private:
-  std::optional<size_t> ModelIndex(const std::string& name) const {
-    for (size_t m = 0; m < records_.size(); ++m) {
-      if (records_[m].name == name) return m;
-    }
-    return std::nullopt;
-  }
-
   bool Accepted(const Detection& detection) const {
     return detection.score >= options_.verify.min_score &&
            detection.visible_fraction >= options_.verify.min_visible_fraction;
@@ -189,28 +173,6 @@ class Recognizer::Impl {
         records_[model], options_, scene,
         [this, model, &scene](const Hypothesis& hypothesis) { return Verify(model, scene, hypothesis); },
         ransac_threads);
-  }
-
-  static void AddInstance(Verified verified, int stride, const cv::Size& size, ModelInFrame* model) {
-    if (model->covered.empty()) model->covered = cv::Mat::zeros(size, CV_8UC1);
-    CoverSurface(verified.surface, stride, &model->covered);
-    model->instances.push_back(std::move(verified));
-  }
-
-  // Each model's priors to follow, in their order. A prior below tracking.min_follow_score is not followed but makes
-  // its model `lost`: it was seen, so even a frame that searches only for lost tracks searches for it.
-  std::vector<ModelInFrame> AssignPriors(const std::vector<Detection>& priors) const {
-    std::vector<ModelInFrame> models(records_.size());
-    for (const Detection& prior : priors) {
-      const std::optional<size_t> m = ModelIndex(prior.model);
-      if (!m) continue;
-      if (prior.score >= options_.tracking.min_follow_score) {
-        models[*m].priors.push_back(&prior);
-      } else {
-        models[*m].lost = true;
-      }
-    }
-    return models;
   }
 
   // Each model's priors tried at their poses (Track), the models on the workers; a prior that fails makes its model
@@ -228,67 +190,6 @@ class Recognizer::Impl {
         }
       }
     });
-  }
-
-  // Marks the models to search in this frame: those with instances not yet found (under kLostTracks only lost ones),
-  // and those with a track due for confirmation, whose tracked instances are set aside meanwhile. Their count.
-  int ChooseModels(SearchScope scope, std::vector<ModelInFrame>* models) const {
-    const int confirm_every = options_.tracking.confirm_every;
-    int count = 0;
-    for (ModelInFrame& model : *models) {
-      const bool due = confirm_every > 0 &&
-                       std::any_of(model.instances.begin(), model.instances.end(), [&](const Verified& instance) {
-                         return instance.detection.frames_followed >= confirm_every;
-                       });
-      if (due) {
-        model.to_confirm = std::move(model.instances);
-        model.instances.clear();
-        model.covered = cv::Mat();
-      }
-      model.search = due || (static_cast<int>(model.instances.size()) < options_.max_instances &&
-                             (scope == SearchScope::kAllModels || model.lost));
-      count += model.search ? 1 : 0;
-    }
-    return count;
-  }
-
-  // A confirming search's instances and the tracked ones it set aside compete on score: best first, each kept unless
-  // it lies mostly (max_overlap) on a kept one's surface, up to max_instances. A kept track that a searched instance
-  // lay on is confirmed (its count starts again); a track the search did not find keeps counting, so its model is
-  // searched again in the next frame.
-  void MergeConfirmation(const cv::Size& image_size, ModelInFrame* model) const {
-    if (model->to_confirm.empty()) return;
-    std::vector<Verified> candidates = std::move(model->to_confirm);
-    model->to_confirm.clear();
-    for (Verified& searched : model->instances) candidates.push_back(std::move(searched));
-    std::stable_sort(candidates.begin(), candidates.end(),
-                     [](const Verified& a, const Verified& b) { return a.detection.score > b.detection.score; });
-    model->instances.clear();
-    model->covered = cv::Mat();
-    for (Verified& candidate : candidates) {
-      Verified* same_surface = nullptr;
-      for (Verified& kept : model->instances) {
-        if (SharedFraction(candidate.surface, kept.surface, image_size) > options_.max_overlap) same_surface = &kept;
-      }
-      if (same_surface != nullptr) {
-        if (same_surface->detection.tracked != candidate.detection.tracked) same_surface->detection.frames_followed = 0;
-        continue;
-      }
-      if (static_cast<int>(model->instances.size()) < options_.max_instances) {
-        AddInstance(std::move(candidate), options_.dense_stride_px, image_size, model);
-      }
-    }
-  }
-
-  // The share of `surface`'s pixels that `other` covers too.
-  static double SharedFraction(const std::vector<cv::Point>& surface, const std::vector<cv::Point>& other,
-                               const cv::Size& image_size) {
-    if (surface.empty()) return 0.0;
-    cv::Mat mask = cv::Mat::zeros(image_size, CV_8UC1);
-    for (const cv::Point& p : other) mask.at<uchar>(p) = 1;
-    const auto shared =
-        std::count_if(surface.begin(), surface.end(), [&](const cv::Point& p) { return mask.at<uchar>(p) != 0; });
-    return static_cast<double>(shared) / static_cast<double>(surface.size());
   }
 
   // Keeps searching only the preselect.models models with the best quick scores (ModelSearch::QuickScore); ties go to
@@ -493,6 +394,7 @@ class Recognizer::Impl {
   const ModelLibrary& library_;
   RecognizerOptions options_;
   std::vector<ModelRecord> records_;  // per model: the library's, colours mapped by its colour matrix if any
+  std::vector<std::string> model_names_;
   Renderer renderer_;
   std::mutex render_mutex_;  // Verify runs on the model workers
   std::vector<MeshId> meshes_;
@@ -505,8 +407,9 @@ cv::Mat Recognizer::Impl::DrawDetections(const RgbdFrame& frame, const std::vect
   std::vector<SceneObject> objects;
   std::vector<Detection> drawn;
   for (const Detection& detection : detections) {
-    if (const std::optional<size_t> m = ModelIndex(detection.model)) {
-      objects.push_back({meshes_[*m], detection.camera_from_object});
+    const auto name = std::find(model_names_.begin(), model_names_.end(), detection.model);
+    if (name != model_names_.end()) {
+      objects.push_back({meshes_[static_cast<size_t>(name - model_names_.begin())], detection.camera_from_object});
       drawn.push_back(detection);
     }
   }

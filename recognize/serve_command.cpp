@@ -8,12 +8,14 @@
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <csignal>
 #include <cstring>
 #include <iostream>
 #include <memory>
 #include <optional>
 #include <string>
+#include <thread>
 
 #include "app/commands.h"
 #include "core/error.h"
@@ -114,12 +116,16 @@ int ListenOn(const std::string& path) {
   if (path.empty() || path.size() >= sizeof(address.sun_path)) {
     ThrowInputError(path, "--socket", "a path of 1 to " + std::to_string(sizeof(address.sun_path) - 1) + " bytes");
   }
+  std::memcpy(address.sun_path, path.c_str(), path.size());
   struct stat status {};
   if (lstat(path.c_str(), &status) == 0) {
     if (!S_ISSOCK(status.st_mode)) ThrowInputError(path, "--socket", "a free path or a stale socket", "another file");
+    const int probe = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    const bool live = probe >= 0 && connect(probe, reinterpret_cast<const sockaddr*>(&address), sizeof(address)) == 0;
+    if (probe >= 0) close(probe);
+    if (live) ThrowInputError(path, "--socket", "a free path or a stale socket", "a service listening there");
     unlink(path.c_str());
   }
-  std::memcpy(address.sun_path, path.c_str(), path.size());
   const int fd = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
   if (fd < 0 || bind(fd, reinterpret_cast<const sockaddr*>(&address), sizeof(address)) != 0 || listen(fd, 8) != 0) {
     const std::string reason = std::strerror(errno);
@@ -135,7 +141,15 @@ void ServeSocket(const std::string& path, RecognitionService& service) {
   std::cerr << "serve: ready, listening on " << path << '\n';
   while (!stop_requested) {
     const int client = accept4(listener, nullptr, nullptr, SOCK_CLOEXEC);
-    if (client < 0) continue;  // EINTR (a stop, checked above) or a client that went before it was accepted
+    if (client < 0) {
+      // EINTR (a stop, checked above) or a client gone before it was accepted: at once; anything else (out of file
+      // descriptors, say) is said and tried again shortly, not in a busy loop.
+      if (errno != EINTR && errno != ECONNABORTED) {
+        std::cerr << "serve: warning: accept: " << std::strerror(errno) << '\n';
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      }
+      continue;
+    }
     service.Reset();
     ServeClient(client, client, service);
     close(client);

@@ -30,7 +30,7 @@ def test_sigterm_during_a_frame_answers_it_then_exits_0(demo_library_path):
     process = start(demo_library_path)
     process.stdin.write(request(id="first"))
     process.stdin.flush()
-    time.sleep(0.1)  # the frame takes about half a second
+    time.sleep(0.3)  # read by then; the frame takes about half a second (answered first if it ends sooner)
     process.send_signal(signal.SIGTERM)
     out, _ = process.communicate(timeout=60)
     assert process.returncode == 0
@@ -96,3 +96,19 @@ def test_a_socket_path_holding_another_file_is_refused(demo_library_path, tmp_pa
     assert run.returncode == 1
     assert "--socket" in run.stderr and str(path) in run.stderr
     assert path.read_text() == "keep me"
+
+
+def test_a_socket_a_service_listens_on_is_not_taken(demo_library_path, tmp_path):
+    path = str(tmp_path / "busy.sock")
+    first = start(demo_library_path, "--socket", path)
+    try:
+        second = subprocess.run([os.environ["ECVPOSE_CLI"], "serve", "--db", str(demo_library_path), "--socket", path],
+                                capture_output=True, text=True, timeout=60, check=False)
+        assert second.returncode == 1 and "a service listening there" in second.stderr
+        client = Client(path)  # the first service still answers
+        assert len(client.ask(request(id=1))["detections"]) == 3
+        client.close()
+    finally:
+        first.send_signal(signal.SIGTERM)
+        first.communicate(timeout=60)
+    assert first.returncode == 0

@@ -2,6 +2,7 @@
 // `recognize --sequence --track`'s detections, a bad request gets an error line and the next one is answered.
 
 #include <fstream>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -12,23 +13,20 @@
 #include "modeldb/model_library.h"
 #include "recognize/recognition_service.h"
 #include "recognize/recognizer.h"
+#include "support/demo_library.h"
 #include "support/test_data.h"
 
 namespace ecv {
 namespace {
 
-class ServeProtocol : public ::testing::Test {
+class ServeProtocol : public test::DemoLibrarySuite {
  protected:
-  static void SetUpTestSuite() {
-    directory_ = new test::TemporaryDirectory();
-    library_ = directory_->File("library.sqlite");
-    const test::CommandResult build = test::RunCli("modeldb build " + std::string(ECV_SOURCE_DIR) +
-                                                   "/models/meshes --views 40 --distance 0.9 --db " + library_);
-    ASSERT_EQ(build.exit_code, 0) << build.output;
+  void SetUp() override {
+    LibraryLoadOptions load;
+    load.build_matchers = false;
+    library_models_ = std::make_unique<ModelLibrary>(ModelLibrary::Load(library_, load));
+    recognizer_ = std::make_unique<Recognizer>(*library_models_);
   }
-  static void TearDownTestSuite() { delete directory_; }
-
-  static std::string DemoFrame() { return std::string(ECV_SOURCE_DIR) + "/models/frame/000001"; }
 
   static std::vector<nlohmann::json> ReadLines(const std::string& path) {
     std::ifstream in(path);
@@ -37,12 +35,9 @@ class ServeProtocol : public ::testing::Test {
     return lines;
   }
 
-  static test::TemporaryDirectory* directory_;
-  static std::string library_;
+  std::unique_ptr<ModelLibrary> library_models_;
+  std::unique_ptr<Recognizer> recognizer_;  // over library_models_, default options
 };
-
-test::TemporaryDirectory* ServeProtocol::directory_ = nullptr;
-std::string ServeProtocol::library_;
 
 TEST_F(ServeProtocol, TenTrackedFramesOfAVideoGiveTheSequencesDetections) {
   const std::string video = test::DataPath("ycbv_subset/Example-Scenes/0001");
@@ -81,11 +76,7 @@ TEST_F(ServeProtocol, TenTrackedFramesOfAVideoGiveTheSequencesDetections) {
 }
 
 TEST_F(ServeProtocol, ABadRequestGetsAnErrorLineAndTheNextOneIsAnswered) {
-  LibraryLoadOptions load;
-  load.build_matchers = false;
-  const ModelLibrary library = ModelLibrary::Load(library_, load);
-  Recognizer recognizer(library);
-  RecognitionService service(recognizer, StreamOptions{});
+  RecognitionService service(*recognizer_, StreamOptions{});
   const auto error_of = [&](const std::string& line) {
     const nlohmann::json response = service.Handle(line);
     EXPECT_FALSE(response.contains("detections")) << line;
@@ -112,11 +103,7 @@ TEST_F(ServeProtocol, ABadRequestGetsAnErrorLineAndTheNextOneIsAnswered) {
 }
 
 TEST_F(ServeProtocol, TrackedRequestsFollowTheirObjectsUntilAResetOrAnUntrackedOne) {
-  LibraryLoadOptions load;
-  load.build_matchers = false;
-  const ModelLibrary library = ModelLibrary::Load(library_, load);
-  Recognizer recognizer(library);
-  RecognitionService service(recognizer, StreamOptions{});
+  RecognitionService service(*recognizer_, StreamOptions{});
   const std::string frame = "\"frame\": \"" + DemoFrame() + "\"";
   const auto tracked_count = [&](const std::string& request) {
     const nlohmann::json response = service.Handle("{" + frame + request + "}");

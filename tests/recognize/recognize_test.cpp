@@ -19,6 +19,7 @@
 #include "modeldb/sql.h"
 #include "recognize/evaluation.h"
 #include "recognize/recognizer.h"
+#include "support/demo_library.h"
 #include "support/test_data.h"
 #include "verify_prior.h"
 
@@ -33,18 +34,9 @@ const GroundTruth* TruthOf(const LoadedFrame& frame, const std::string& model) {
   return nullptr;
 }
 
-class RecognizeEndToEnd : public ::testing::Test {
+class RecognizeEndToEnd : public test::DemoLibrarySuite {
  protected:
-  static void SetUpTestSuite() {
-    directory_ = new test::TemporaryDirectory();
-    library_ = directory_->File("library.sqlite");
-    const test::CommandResult build = test::RunCli("modeldb build " + std::string(ECV_SOURCE_DIR) +
-                                                   "/models/meshes --views 40 --distance 0.9 --db " + library_);
-    ASSERT_EQ(build.exit_code, 0) << build.output;
-  }
-  static void TearDownTestSuite() { delete directory_; }
-
-  static std::string Frame() { return std::string(ECV_SOURCE_DIR) + "/models/frame/000001"; }
+  static std::string Frame() { return DemoFrame(); }
 
   // The library built for the suite (only `names`, when given), without matchers: the Recognizer makes its own.
   static ModelLibrary Library(const std::vector<std::string>& names = {}) {
@@ -67,9 +59,6 @@ class RecognizeEndToEnd : public ::testing::Test {
     load.build_matchers = false;
     return ModelLibrary::Load(path, load);
   }
-
-  static test::TemporaryDirectory* directory_;
-  static std::string library_;
 };
 
 // Runs of the recognizer on frames of video 0001 (the cracker box, sugar box and mustard bottle), upright or as a
@@ -107,9 +96,6 @@ struct RollRuns {
     }
   }
 };
-
-test::TemporaryDirectory* RecognizeEndToEnd::directory_ = nullptr;
-std::string RecognizeEndToEnd::library_;
 
 TEST_F(RecognizeEndToEnd, FindsTheObjectsOfTheDemoFrameWithinTenthOfTheirDiameter) {
   const std::string json = directory_->File("detections.json");
