@@ -189,20 +189,21 @@ void BindLibrary(py::module_& m) {
         const std::vector<std::string> paths = py::isinstance<py::str>(meshes)
                                                    ? std::vector<std::string>{meshes.cast<std::string>()}
                                                    : meshes.cast<std::vector<std::string>>();
-        const BuildArguments args{std::move(name),
-                                  std::move(unit),
-                                  std::move(object_from_mesh),
-                                  symmetric,
-                                  allow_missing_textures,
-                                  views,
-                                  distance,
-                                  std::move(camera),
-                                  size,
-                                  std::move(shading),
-                                  threads,
-                                  stored_mesh,
-                                  mesh_texture_size,
-                                  std::move(feature_settings)};
+        BuildArguments args;
+        args.name = std::move(name);
+        args.unit = std::move(unit);
+        args.object_from_mesh = std::move(object_from_mesh);
+        args.symmetric = symmetric;
+        args.allow_missing_textures = allow_missing_textures;
+        args.views = views;
+        args.distance = distance;
+        args.camera = std::move(camera);
+        args.size = size;
+        args.shading = std::move(shading);
+        args.threads = threads;
+        args.stored_mesh = stored_mesh;
+        args.mesh_texture_size = mesh_texture_size;
+        args.feature_settings = std::move(feature_settings);
         return BuildModels(db, paths, args, progress);
       },
       py::arg("db"), py::arg("meshes"), py::kw_only(), py::arg("name") = py::none(), py::arg("unit") = "m",
