@@ -32,15 +32,19 @@ progress: called as progress(model, view, views) after each view.
 
 Returns the names of the models built. Raises InputError naming each model that failed, after building the others.)";
 
-inline constexpr const char* kRecognizerDoc = R"(A recognizer over `library`, as `ecvpose recognize` runs.
+inline constexpr const char* kRecognizerDoc = R"(Recognizer(library, **options): a recognizer over `library`.
 
-threads, seed: worker threads (the result is the same for any count) and the random seed.
-track: follow objects from call to call (each previous detection tried first at its pose); search_every: with
-    track, models not tracked are searched on every N-th call only; track_score: a detection is followed only
-    while it scores at least this; confirm_every: a track's model is searched again after this many frames.
-hypotheses: "context", "ppf" or "both": where poses come from.
-views_per_model, min_score, max_instances, preselect: the search (as the recognize flags of those names).
-icp, contour, edge_weight, matcher: refinement and verification ("kd-forest" or "bytes").
+The options are the flags of `ecvpose recognize` with underscores, with the same defaults:
+threads=2, seed=1: worker threads (the result is the same for any count) and the random seed.
+track=False: follow objects from call to call (each previous detection tried first at its pose);
+search_every=1: with track, models not followed are searched on every N-th call only;
+track_score=0.3: a detection is followed only while it scores at least this;
+confirm_every=5: a followed object's model is searched again after this many frames (0: never).
+hypotheses="context": where poses come from, "context", "ppf" or "both".
+views_per_model, good_enough_score, give_up_after, give_up_score, preselect, ranking_checks, min_score,
+max_instances: the search; icp=True, fast_icp=False, nearest_inliers=False, contour=True, edge_weight,
+matcher="kd-forest" ("bytes"): refinement, RANSAC's inliers and verification.
+An unknown keyword or a value out of range raises InputError naming it.
 
 Loads the models' meshes for verification (about a second for seven models).)";
 

@@ -91,6 +91,79 @@ void CheckRange(const char* name, double value, double low, double high) {
   }
 }
 
+template <typename T>
+T Cast(const std::string& key, const py::handle& value, const char* expected) {
+  try {
+    return value.cast<T>();
+  } catch (const py::cast_error&) {
+    ThrowInputError(key, "", expected, py::repr(value).cast<std::string>());
+  }
+}
+
+// One keyword argument of Recognizer, checked and set as the recognize flag of that name.
+void SetKeyword(const std::string& key, const py::handle& value, RecognizeArguments* args) {
+  RecognizerOptions& o = args->options;
+  const auto number = [&](double low, double high) {
+    const double x = Cast<double>(key, value, "a number");
+    CheckRange(key.c_str(), x, low, high);
+    return x;
+  };
+  const auto count = [&](int low) {
+    const int n = Cast<int>(key, value, "a whole number");
+    CheckRange(key.c_str(), n, low, 1e9);
+    return n;
+  };
+  const auto flag = [&] { return Cast<bool>(key, value, "True or False"); };
+  if (key == "threads") {
+    args->threads = count(1);
+  } else if (key == "seed") {
+    args->seed = static_cast<uint64_t>(count(0));
+  } else if (key == "track") {
+    args->track = flag();
+  } else if (key == "search_every") {
+    args->search_every = count(1);
+  } else if (key == "track_score") {
+    o.tracking.min_follow_score = number(0, 1);
+  } else if (key == "confirm_every") {
+    o.tracking.confirm_every = count(0);
+  } else if (key == "hypotheses") {
+    o.point_pairs.source = ParseHypothesisSource(Cast<std::string>(key, value, "a string"), key);
+  } else if (key == "views_per_model") {
+    o.views_per_model = count(1);
+  } else if (key == "good_enough_score") {
+    o.good_enough_score = number(0, 1e9);
+  } else if (key == "give_up_after") {
+    o.give_up_after_views = count(0);
+  } else if (key == "give_up_score") {
+    o.give_up_below_score = number(0, 1e9);
+  } else if (key == "preselect") {
+    o.preselect.models = count(0);
+  } else if (key == "ranking_checks") {
+    o.ranking.checks = count(0);
+  } else if (key == "min_score") {
+    o.verify.min_score = number(0, 1);
+  } else if (key == "max_instances") {
+    o.max_instances = count(1);
+  } else if (key == "icp") {
+    o.refine = flag();
+  } else if (key == "fast_icp") {
+    o.projective_icp = flag();
+  } else if (key == "nearest_inliers") {
+    o.projective_inliers = !flag();
+  } else if (key == "contour") {
+    o.verify.contour_falloff = flag() ? RecognizerOptions().verify.contour_falloff : 0.0;
+  } else if (key == "edge_weight") {
+    o.verify.edge_weight = number(0, 1);
+  } else if (key == "matcher") {
+    const std::string matcher = Cast<std::string>(key, value, "a string");
+    if (matcher != "kd-forest" && matcher != "bytes") ThrowInputError(key, "", "kd-forest or bytes", matcher);
+    o.match.index = matcher == "bytes" ? MatchIndex::kBytes : RecognizerOptions().match.index;
+  } else {
+    ThrowInputError("Recognizer", key, "a keyword of the recognize flags (see help(ecvpose.Recognizer))",
+                    "an unknown keyword");
+  }
+}
+
 py::list DetectionList(const RecognitionResult& result) {
   py::list detections;
   for (const Detection& detection : result.detections) detections.append(detection);
@@ -213,47 +286,14 @@ void BindFrame(py::module_& m) {
 void BindRecognizer(py::module_& m) {
   BindDetection(m);
   BindFrame(m);
-  const RecognizerOptions defaults;
   py::class_<StreamRecognizer>(m, "Recognizer", "Finds a library's models in RGB-D frames.")
-      .def(py::init([](std::shared_ptr<Library> library, int threads, uint64_t seed, bool track, int search_every,
-                       double track_score, int confirm_every, std::string hypotheses, int views_per_model,
-                       double min_score, int max_instances, int preselect, bool icp, bool contour, double edge_weight,
-                       std::string matcher) {
-             CheckRange("threads", threads, 1, 1024);
-             CheckRange("search_every", search_every, 1, 1e9);
-             CheckRange("track_score", track_score, 0, 1);
-             CheckRange("confirm_every", confirm_every, 0, 1e9);
-             CheckRange("views_per_model", views_per_model, 1, 1e9);
-             CheckRange("min_score", min_score, 0, 1);
-             CheckRange("max_instances", max_instances, 1, 1e9);
-             CheckRange("preselect", preselect, 0, 1e9);
-             CheckRange("edge_weight", edge_weight, 0, 1);
-             RecognizeArguments args{threads, seed, track, search_every, RecognizerOptions{}};
-             RecognizerOptions& o = args.options;
-             o.tracking.min_follow_score = track_score;
-             o.tracking.confirm_every = confirm_every;
-             o.point_pairs.source = ParseHypothesisSource(hypotheses, "hypotheses");
-             o.views_per_model = views_per_model;
-             o.verify.min_score = min_score;
-             o.max_instances = max_instances;
-             o.preselect.models = preselect;
-             o.refine = icp;
-             if (!contour) o.verify.contour_falloff = 0.0;
-             o.verify.edge_weight = edge_weight;
-             if (matcher != "kd-forest" && matcher != "bytes") {
-               ThrowInputError("matcher", "", "kd-forest or bytes", matcher);
-             }
-             if (matcher == "bytes") o.match.index = MatchIndex::kBytes;
+      .def(py::init([](std::shared_ptr<Library> library, const py::kwargs& options) {
+             RecognizeArguments args;
+             args.options = RecognizerOptions();
+             for (const auto& [key, value] : options) SetKeyword(key.cast<std::string>(), value, &args);
              return MakeRecognizer(std::move(library), std::move(args));
            }),
-           py::arg("library"), py::kw_only(), py::arg("threads") = 2, py::arg("seed") = 1, py::arg("track") = false,
-           py::arg("search_every") = 1, py::arg("track_score") = defaults.tracking.min_follow_score,
-           py::arg("confirm_every") = defaults.tracking.confirm_every,
-           py::arg("hypotheses") = HypothesisSourceName(defaults.point_pairs.source),
-           py::arg("views_per_model") = defaults.views_per_model, py::arg("min_score") = defaults.verify.min_score,
-           py::arg("max_instances") = defaults.max_instances, py::arg("preselect") = defaults.preselect.models,
-           py::arg("icp") = true, py::arg("contour") = true, py::arg("edge_weight") = defaults.verify.edge_weight,
-           py::arg("matcher") = "kd-forest", kRecognizerDoc)
+           py::arg("library"), kRecognizerDoc)
       .def("recognize", &RecognizeArrays, py::arg("color"), py::arg("depth"), py::arg("K"),
            py::arg("depth_scale") = py::none(),
            "Detections in one frame, best score first. color: HxWx3 uint8 RGB; depth: HxW float32 metres (0: "

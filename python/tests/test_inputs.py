@@ -59,6 +59,9 @@ def test_bad_options_files_and_names_are_named(demo_library, demo_library_path, 
     raises_naming("hypotheses", ecvpose.Recognizer, demo_library, hypotheses="colour")
     raises_naming("search_every", ecvpose.Recognizer, demo_library, search_every=3)  # without track
     raises_naming("matcher", ecvpose.Recognizer, demo_library, matcher="brute")
+    raises_naming("colour_weight", ecvpose.Recognizer, demo_library, colour_weight=1.0)  # not a recognize flag
+    raises_naming("track", ecvpose.Recognizer, demo_library, track="yes")
+    raises_naming("views_per_model", ecvpose.Recognizer, demo_library, views_per_model=2.5)
     missing = str(tmp_path / "missing.sqlite")
     raises_naming(missing, ecvpose.ModelLibrary.open, missing)
     not_a_library = tmp_path / "text.sqlite"
