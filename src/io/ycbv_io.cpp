@@ -36,16 +36,17 @@ void AppendAs(const void* data, size_t count, std::vector<double>* out) {
   out->assign(typed, typed + count);
 }
 
-MatArray ReadNumeric(mat_t* file, const std::string& path, const char* name) {
-  // The variable's header first: dimensions a meta file cannot have are refused before matio allocates for them.
-  constexpr double kMaxValues = 1e7;
+// The variable `name`, of at most `max_values` values: its header is read first, so that dimensions the meta file
+// cannot have are refused before matio allocates for them.
+MatArray ReadNumeric(mat_t* file, const std::string& path, const char* name, size_t max_values) {
   {
     std::unique_ptr<matvar_t, MatVarFreer> info(Mat_VarReadInfo(file, name));
     if (!info) ThrowInputError(path, name, "a numeric variable", "none");
     double values = 1.0;
     for (int i = 0; i < info->rank; ++i) values *= static_cast<double>(info->dims[i]);
-    if (info->rank < 0 || info->rank > 8 || !(values <= kMaxValues)) {
-      ThrowInputError(path, name, "an array of at most 10^7 values", std::to_string(values));
+    if (info->rank < 0 || info->rank > 8 || !(values <= static_cast<double>(max_values))) {
+      ThrowInputError(path, name, "an array of at most " + std::to_string(max_values) + " values",
+                      std::to_string(values));
     }
   }
   std::unique_ptr<matvar_t, MatVarFreer> variable(Mat_VarRead(file, name));
@@ -104,12 +105,15 @@ LoadedFrame LoadYcbvFrame(const std::string& prefix) {
   std::unique_ptr<mat_t, MatFileCloser> file(Mat_Open(meta_path.c_str(), MAT_ACC_RDONLY));
   if (!file) ThrowInputError(meta_path, "meta", "a readable MATLAB file (YCB-Video -meta.mat)");
 
-  const MatArray intrinsics = ReadNumeric(file.get(), meta_path, "intrinsic_matrix");
+  // A frame holds each of the 21 classes at most a few times: 1000 objects is far beyond any real frame, and keeps a
+  // broken file from costing more than a few hundred kilobytes.
+  constexpr size_t kMaxObjects = 1000;
+  const MatArray intrinsics = ReadNumeric(file.get(), meta_path, "intrinsic_matrix", 9);
   if (intrinsics.values.size() != 9) ThrowInputError(meta_path, "intrinsic_matrix", "a 3x3 matrix");
-  const MatArray factor = ReadNumeric(file.get(), meta_path, "factor_depth");
+  const MatArray factor = ReadNumeric(file.get(), meta_path, "factor_depth", 1);
   if (factor.values.size() != 1) ThrowInputError(meta_path, "factor_depth", "a scalar");
-  const MatArray classes = ReadNumeric(file.get(), meta_path, "cls_indexes");
-  const MatArray poses = ReadNumeric(file.get(), meta_path, "poses");
+  const MatArray classes = ReadNumeric(file.get(), meta_path, "cls_indexes", kMaxObjects);
+  const MatArray poses = ReadNumeric(file.get(), meta_path, "poses", 12 * kMaxObjects);
   const size_t num_objects = classes.values.size();
   if (poses.values.size() != 12 * num_objects || poses.dims.size() < 2 || poses.dims[0] != 3 || poses.dims[1] != 4) {
     ThrowInputError(meta_path, "poses", "3x4xN with N = " + std::to_string(num_objects) + " (cls_indexes)");

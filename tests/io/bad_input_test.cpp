@@ -88,6 +88,16 @@ TEST_F(BadInput, MalformedFrameJson) {
   WriteText(path, R"({"color": "a.png", "depth": "b.png", "depth_scale": 1000, "camera": [1, 2, 3]})");
   EXPECT_THAT(InputErrorMessage([&] { LoadFrameJson(path); }),
               AllOf(HasSubstr(path), HasSubstr("camera"), HasSubstr("[fx, fy, cx, cy]")));
+  const std::string frame = R"({"color": ")" + color_ + R"(", "depth": ")" + depth_ +
+                            R"(", "depth_scale": 10000, "camera": [1066.8, 1067.5, 313, 241])";
+  WriteText(path, frame + R"(, "scene_id": -1, "image_id": 2})");
+  EXPECT_THAT(InputErrorMessage([&] { LoadFrameJson(path); }), AllOf(HasSubstr("scene_id"), HasSubstr(">= 0")));
+  WriteText(path, frame + R"(, "scene_id": 4})");
+  EXPECT_THAT(InputErrorMessage([&] { LoadFrameJson(path); }), HasSubstr("image_id"));
+  WriteText(path, frame + R"(, "image_id": 7})");
+  const LoadedFrame ids = LoadFrameJson(path);
+  EXPECT_EQ(ids.scene_id, 0);  // an image id alone: scene 0
+  EXPECT_EQ(ids.image_id, 7);
 }
 
 TEST_F(BadInput, NanInIntrinsics) {

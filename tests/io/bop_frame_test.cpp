@@ -45,6 +45,8 @@ TEST(BopFrame, ReadsLmoImageCameraAndEightPoses) {
   EXPECT_EQ(loaded.ground_truth[1].object_box, cv::Rect(376, 226, 60, 91));
   // Millimetres in scene_gt.json -> metres.
   EXPECT_NEAR(loaded.ground_truth[1].camera_from_object.translation().z(), 0.96478389285, 1e-9);
+  EXPECT_EQ(loaded.scene_id, 2);  // the scene folder's number
+  EXPECT_EQ(loaded.image_id, 3);
 }
 
 // The message of LoadFrame on a copy of LM-O scene 000002, image 3, in `directory` with each of its JSON files

@@ -2,7 +2,10 @@
 // label image and the depth image; an object pasted from another frame; a frame JSON written and read back.
 
 #include <algorithm>
+#include <filesystem>
 #include <map>
+
+#include <matio.h>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -55,6 +58,39 @@ TEST(YcbvFrame, ReadsImagesIntrinsicsAndDepthScale) {
   for (const GroundTruth& truth : loaded.ground_truth) names.push_back(truth.object_name);
   EXPECT_EQ(names, (std::vector<std::string>{"002_master_chef_can", "003_cracker_box", "004_sugar_box",
                                              "006_mustard_bottle"}));
+  EXPECT_EQ(loaded.scene_id, 1);  // the video and frame numbers: BOP's scene and image ids
+  EXPECT_EQ(loaded.image_id, 1);
+}
+
+// A meta file whose object list is longer than any frame's is refused before its values are read (a broken file
+// costs at most a few hundred kilobytes).
+TEST(YcbvFrame, AMetaFileWithMoreObjectsThanAFrameHoldsIsRefused) {
+  test::TemporaryDirectory directory;
+  const std::string prefix = directory.File("000001"), source = FramePrefix("0001", 1);
+  for (const char* suffix : {"-color.png", "-depth.png"}) {
+    std::filesystem::copy_file(source + suffix, prefix + suffix);
+  }
+  mat_t* file = Mat_CreateVer((prefix + "-meta.mat").c_str(), nullptr, MAT_FT_MAT5);
+  ASSERT_NE(file, nullptr);
+  const auto write = [&](const char* name, std::vector<size_t> dims, std::vector<double> values) {
+    matvar_t* variable =
+        Mat_VarCreate(name, MAT_C_DOUBLE, MAT_T_DOUBLE, static_cast<int>(dims.size()), dims.data(), values.data(), 0);
+    Mat_VarWrite(file, variable, MAT_COMPRESSION_NONE);
+    Mat_VarFree(variable);
+  };
+  write("intrinsic_matrix", {3, 3}, {1066.778, 0, 0, 0, 1067.487, 0, 312.9869, 241.3109, 1});
+  write("factor_depth", {1, 1}, {10000});
+  write("cls_indexes", {1001, 1}, std::vector<double>(1001, 2.0));
+  write("poses", {3, 4, 1001}, std::vector<double>(12 * 1001, 0.0));
+  Mat_Close(file);
+  try {
+    LoadYcbvFrame(prefix);
+    FAIL() << "expected an InputError";
+  } catch (const InputError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("cls_indexes"), std::string::npos) << message;
+    EXPECT_NE(message.find("at most 1000 values"), std::string::npos) << message;
+  }
 }
 
 // The check on 0001/000001: each object's origin projects onto its own label pixels.
