@@ -62,14 +62,31 @@ TEST(YcbvFrame, ReadsImagesIntrinsicsAndDepthScale) {
   EXPECT_EQ(loaded.image_id, 1);
 }
 
-// A meta file whose object list is longer than any frame's is refused before its values are read (a broken file
-// costs at most a few hundred kilobytes).
-TEST(YcbvFrame, AMetaFileWithMoreObjectsThanAFrameHoldsIsRefused) {
-  test::TemporaryDirectory directory;
+// A copy of frame 0001/000001's images in `directory`; its prefix.
+std::string CopyOfFrameImages(const test::TemporaryDirectory& directory) {
   const std::string prefix = directory.File("000001"), source = FramePrefix("0001", 1);
   for (const char* suffix : {"-color.png", "-depth.png"}) {
     std::filesystem::copy_file(source + suffix, prefix + suffix);
   }
+  return prefix;
+}
+
+// The message of LoadYcbvFrame's InputError on `prefix`, or a failure.
+std::string Refusal(const std::string& prefix) {
+  try {
+    LoadYcbvFrame(prefix);
+  } catch (const InputError& error) {
+    return error.what();
+  }
+  ADD_FAILURE() << "expected an InputError";
+  return "";
+}
+
+// A meta file whose object list is longer than any frame's is refused before its values are read (a broken file
+// costs at most a few hundred kilobytes).
+TEST(YcbvFrame, AMetaFileWithMoreObjectsThanAFrameHoldsIsRefused) {
+  test::TemporaryDirectory directory;
+  const std::string prefix = CopyOfFrameImages(directory);
   mat_t* file = Mat_CreateVer((prefix + "-meta.mat").c_str(), nullptr, MAT_FT_MAT5);
   ASSERT_NE(file, nullptr);
   const auto write = [&](const char* name, std::vector<size_t> dims, std::vector<double> values) {
@@ -83,14 +100,26 @@ TEST(YcbvFrame, AMetaFileWithMoreObjectsThanAFrameHoldsIsRefused) {
   write("cls_indexes", {1001, 1}, std::vector<double>(1001, 2.0));
   write("poses", {3, 4, 1001}, std::vector<double>(12 * 1001, 0.0));
   Mat_Close(file);
-  try {
-    LoadYcbvFrame(prefix);
-    FAIL() << "expected an InputError";
-  } catch (const InputError& error) {
-    const std::string message = error.what();
-    EXPECT_NE(message.find("cls_indexes"), std::string::npos) << message;
-    EXPECT_NE(message.find("at most 1000 values"), std::string::npos) << message;
-  }
+  const std::string message = Refusal(prefix);
+  EXPECT_NE(message.find("cls_indexes"), std::string::npos) << message;
+  EXPECT_NE(message.find("at most 1000 values"), std::string::npos) << message;
+}
+
+// Version 4 MAT-files (no text header), which matio reads by their own counts alone, are refused before it sees them.
+TEST(YcbvFrame, AVersion4MetaFileIsRefusedNamingTheVersion) {
+  test::TemporaryDirectory directory;
+  const std::string prefix = CopyOfFrameImages(directory);
+  mat_t* file = Mat_CreateVer((prefix + "-meta.mat").c_str(), nullptr, MAT_FT_MAT4);
+  ASSERT_NE(file, nullptr);
+  size_t dims[2] = {1, 1};
+  double factor = 10000;
+  matvar_t* variable = Mat_VarCreate("factor_depth", MAT_C_DOUBLE, MAT_T_DOUBLE, 2, dims, &factor, 0);
+  Mat_VarWrite(file, variable, MAT_COMPRESSION_NONE);
+  Mat_VarFree(variable);
+  Mat_Close(file);
+  const std::string message = Refusal(prefix);
+  EXPECT_NE(message.find("version 5 or later"), std::string::npos) << message;
+  EXPECT_NE(message.find("no such header"), std::string::npos) << message;
 }
 
 // The check on 0001/000001: each object's origin projects onto its own label pixels.
