@@ -10,8 +10,8 @@
 #include <thread>
 
 #include "core/error.h"
+#include "io/files.h"
 #include "io/frame_io.h"
-#include "io/paths.h"
 
 namespace ecv::app {
 namespace fs = std::filesystem;
@@ -32,13 +32,8 @@ LineOutput::~LineOutput() {
 }
 
 void LineOutput::Write(const std::string& text) {
-  size_t done = 0;
-  while (done < text.size()) {
-    const ssize_t wrote = write(fd_, text.data() + done, text.size() - done);
-    if (wrote < 0 && errno == EINTR) continue;
-    if (wrote <= 0)
-      ThrowInputError(path_ == "-" ? "standard output" : path_, "output", "room to write", std::strerror(errno));
-    done += static_cast<size_t>(wrote);
+  if (!WriteAll(fd_, text.data(), text.size())) {
+    ThrowInputError(path_ == "-" ? "standard output" : path_, "output", "room to write", std::strerror(errno));
   }
 }
 

@@ -19,6 +19,7 @@
 
 #include "app/commands.h"
 #include "core/error.h"
+#include "io/files.h"
 #include "recognize/recognition_service.h"
 #include "recognize/recognize_flags.h"
 
@@ -84,18 +85,6 @@ class LineReader {
   bool skipping_ = false;
 };
 
-// Writes all of `text`; false when the reader has gone.
-bool WriteAll(int fd, const std::string& text) {
-  size_t done = 0;
-  while (done < text.size()) {
-    const ssize_t wrote = write(fd, text.data() + done, text.size() - done);
-    if (wrote < 0 && errno == EINTR) continue;
-    if (wrote <= 0) return false;
-    done += static_cast<size_t>(wrote);
-  }
-  return true;
-}
-
 // Answers the requests of one client, a line each, until its input ends, it goes or a stop is requested.
 void ServeClient(int in, int out, RecognitionService& service) {
   LineReader reader(in);
@@ -105,7 +94,8 @@ void ServeClient(int in, int out, RecognitionService& service) {
     const nlohmann::json response =
         too_long ? nlohmann::json{{"id", nullptr}, {"error", "request: expected a line of at most 1 MiB"}}
                  : service.Handle(*line);
-    if (!WriteAll(out, response.dump() + "\n") || stop_requested) return;
+    const std::string text = response.dump() + "\n";
+    if (!WriteAll(out, text.data(), text.size()) || stop_requested) return;
   }
 }
 

@@ -1,6 +1,7 @@
 #include "arrays.h"
 
 #include <cmath>
+#include <cstring>
 #include <sstream>
 
 #include "core/error.h"
@@ -29,6 +30,29 @@ py::array_t<double> DoubleArray(const py::object& object, const std::string& nam
   return array;
 }
 
+// The array's pixels as an image of `type` (HxW, or HxWxC for C channels): a view of its memory where its pixels are
+// packed (any row stride, a crop of a wider image say), else one packed copy (a reversed axis, every other column).
+cv::Mat PixelsOf(const py::array& array, int type) {
+  const int rows = static_cast<int>(array.shape(0)), cols = static_cast<int>(array.shape(1));
+  const auto pixel = static_cast<py::ssize_t>(CV_ELEM_SIZE(type)), item = static_cast<py::ssize_t>(CV_ELEM_SIZE1(type));
+  const int channels = CV_MAT_CN(type);
+  const bool packed =
+      array.strides(1) == pixel && (channels == 1 || array.strides(2) == item) && array.strides(0) >= pixel * cols;
+  if (packed) return cv::Mat(rows, cols, type, const_cast<void*>(array.data()), static_cast<size_t>(array.strides(0)));
+  cv::Mat copy(rows, cols, type);
+  const char* base = static_cast<const char*>(array.data());
+  for (int v = 0; v < rows; ++v) {
+    for (int u = 0; u < cols; ++u) {
+      for (int c = 0; c < channels; ++c) {
+        const char* from =
+            base + v * array.strides(0) + u * array.strides(1) + (channels > 1 ? c * array.strides(2) : 0);
+        std::memcpy(copy.ptr(v) + u * pixel + c * item, from, static_cast<size_t>(item));
+      }
+    }
+  }
+  return copy;
+}
+
 }  // namespace
 
 cv::Mat ColorImage(const py::array& array, const std::string& name) {
@@ -36,12 +60,7 @@ cv::Mat ColorImage(const py::array& array, const std::string& name) {
   if (!py::isinstance<py::array_t<uint8_t>>(array) || array.ndim() != 3 || array.shape(2) != 3 || array.size() == 0) {
     ThrowInputError(name, "", kExpected, Describe(array));
   }
-  const int rows = static_cast<int>(array.shape(0)), cols = static_cast<int>(array.shape(1));
-  if (array.strides(2) == 1 && array.strides(1) == 3 && array.strides(0) >= 3 * cols) {
-    return cv::Mat(rows, cols, CV_8UC3, const_cast<void*>(array.data()), static_cast<size_t>(array.strides(0)));
-  }
-  const auto packed = py::array_t<uint8_t, py::array::c_style>::ensure(array);
-  return cv::Mat(rows, cols, CV_8UC3, const_cast<uint8_t*>(packed.data())).clone();
+  return PixelsOf(array, CV_8UC3);
 }
 
 cv::Mat DepthImage(const py::array& array, const py::object& depth_scale, const std::string& name) {
@@ -54,17 +73,8 @@ cv::Mat DepthImage(const py::array& array, const py::object& depth_scale, const 
     ThrowInputError("depth_scale", "", "None with float32 depth in metres (it is for uint16 depth)",
                     py::str(depth_scale).cast<std::string>());
   }
-  const int rows = static_cast<int>(array.shape(0)), cols = static_cast<int>(array.shape(1));
-  const size_t item = metres ? sizeof(float) : sizeof(uint16_t);
-  const int type = metres ? CV_32FC1 : CV_16UC1;
-  const bool packed =
-      array.strides(1) == static_cast<py::ssize_t>(item) && array.strides(0) >= static_cast<py::ssize_t>(item) * cols;
-  if (metres && packed) {
-    return cv::Mat(rows, cols, type, const_cast<void*>(array.data()), static_cast<size_t>(array.strides(0)));
-  }
-  const py::array contiguous = py::array::ensure(array, py::array::c_style);
-  const cv::Mat view(rows, cols, type, const_cast<void*>(contiguous.data()));
-  if (metres) return view.clone();
+  const cv::Mat pixels = PixelsOf(array, metres ? CV_32FC1 : CV_16UC1);
+  if (metres) return pixels;
   double scale = 0.0;
   try {
     scale = depth_scale.is_none() ? 0.0 : depth_scale.cast<double>();
@@ -76,7 +86,7 @@ cv::Mat DepthImage(const py::array& array, const py::object& depth_scale, const 
                     py::str(depth_scale).cast<std::string>());
   }
   cv::Mat depth;
-  view.convertTo(depth, CV_32FC1, 1.0 / scale);
+  pixels.convertTo(depth, CV_32FC1, 1.0 / scale);
   return depth;
 }
 

@@ -7,8 +7,8 @@
 #include <filesystem>
 
 #include "core/error.h"
+#include "io/files.h"
 #include "io/frame_io.h"
-#include "io/paths.h"
 #include "io/pose_io.h"
 
 namespace ecv {

@@ -11,7 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
-#include "io/paths.h"
+#include "io/files.h"
 #include "io/pose_io.h"
 
 namespace ecv {

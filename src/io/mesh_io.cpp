@@ -31,9 +31,9 @@
 
 #include "core/error.h"
 #include "core/pose.h"
+#include "io/files.h"
 #include "io/frame_io.h"
 #include "io/mesh_blob.h"
-#include "io/paths.h"
 #include "io/ply_check.h"
 
 namespace ecv {
@@ -164,19 +164,6 @@ TriangleMesh ImportMesh(const std::string& path) {
     if (!part.triangles.empty()) mesh.parts.push_back(std::move(part));
   }
   return mesh;
-}
-
-// Writes all of `bytes` to `fd` (false when the pipe closes).
-bool WriteAll(int fd, const void* bytes, size_t size) {
-  const auto* data = static_cast<const char*>(bytes);
-  while (size > 0) {
-    const ssize_t written = write(fd, data, size);
-    if (written < 0 && errno == EINTR) continue;
-    if (written <= 0) return false;
-    data += written;
-    size -= static_cast<size_t>(written);
-  }
-  return true;
 }
 
 // Where the mesh importer program is: $ECVPOSE_MESH_IMPORTER, else in the folder "ecvpose" beside the library (or

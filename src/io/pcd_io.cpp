@@ -6,8 +6,8 @@
 #include <filesystem>
 
 #include "core/error.h"
+#include "io/files.h"
 #include "io/frame_io.h"
-#include "io/paths.h"
 #include "io/pcd_file.h"
 #include "io/points_io.h"
 

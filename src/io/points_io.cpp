@@ -5,7 +5,7 @@
 #include <sstream>
 
 #include "core/error.h"
-#include "io/paths.h"
+#include "io/files.h"
 
 namespace ecv {
 

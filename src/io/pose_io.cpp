@@ -6,7 +6,7 @@
 #include "core/error.h"
 #include "core/pose.h"
 #include "io/atomic_file.h"
-#include "io/paths.h"
+#include "io/files.h"
 
 namespace ecv {
 

@@ -1,5 +1,8 @@
 #pragma once
 
+// Files without exceptions of the standard library's making: paths that may not exist, descriptors that may close.
+
+#include <cstddef>
 #include <filesystem>
 
 namespace ecv {
@@ -11,5 +14,9 @@ bool PathExists(const std::filesystem::path& path);
 
 /// Whether `path` names an existing folder; false, never a throw, where it cannot be looked at.
 bool IsDirectory(const std::filesystem::path& path);
+
+/// Writes all `size` bytes to the file descriptor `fd`, through short writes and interrupted calls; false when the
+/// other end has gone (a closed pipe or socket) or the write fails (errno says why).
+bool WriteAll(int fd, const void* bytes, size_t size);
 
 }  // namespace ecv
