@@ -72,6 +72,7 @@ void ModelBuildOptions::Check() const {
   features.ecv.Check();
   features.descriptor.Check();
   mesh_blob.Check();
+  point_pair_sampling.Check();
   if (threads < 1) ThrowInputError("model build options", "threads", "at least 1", std::to_string(threads));
 }
 
@@ -161,6 +162,15 @@ BuildResult BuildModel(const ModelSource& source, const ModelBuildOptions& optio
     ThrowInputError(source.mesh_path, "views", "ECV primitives in its rendered views",
                     "none in any of " + std::to_string(record.views.size()) + " views (the mesh is " +
                         std::to_string(record.diameter_m) + " m across; is --unit right?)");
+  }
+  if (options.point_pairs) {
+    start = Clock::now();
+    record.point_pairs = MakePointPairRecord(mesh, options.point_pair_sampling);
+    result.timings.point_pairs_ms = MillisecondsSince(start);
+    if (!record.point_pairs->refusal.empty()) {
+      result.warnings.push_back(source.mesh_path + ": no point pair points, so no shape-driven pose hypotheses (" +
+                                record.point_pairs->refusal + ")");
+    }
   }
   return result;
 }

@@ -44,12 +44,16 @@ struct ModelBuildOptions {
   /// mesh_blob.max_texture_size (the recognizer's own cap).
   bool store_mesh = true;
   MeshBlobOptions mesh_blob;
+  /// Draw the model's point pair points (ModelRecord::point_pairs) for shape-driven pose hypotheses. A mesh too
+  /// small, flat or coarse for them is stored without, with a warning.
+  bool point_pairs = true;
+  PpfModelSampling point_pair_sampling;
   int threads = 1;  ///< worker threads describing each view (ComputeDescriptors); the model does not depend on it
 
   /// Throws InputError naming the field for nonsense values (via the parts' Check()).
   void Check() const;
 
-  /// The default sampling: 60 views over the whole sphere.
+  /// The default sampling: 40 views over the whole sphere.
   static ViewSamplingOptions DefaultSampling();
 };
 
@@ -75,11 +79,12 @@ using BuildProgressCallback = std::function<void(const BuildProgress&)>;
 
 /// Time per step of a build, milliseconds (summed over the views).
 struct BuildTimings {
-  double load_ms = 0.0;      ///< reading the mesh and its textures, hashing them, packing it (store_mesh)
-  double upload_ms = 0.0;    ///< uploading the mesh to the renderer
-  double render_ms = 0.0;    ///< rendering the views
-  double extract_ms = 0.0;   ///< ECV primitives and the move into the object frame
-  double describe_ms = 0.0;  ///< context descriptors
+  double load_ms = 0.0;         ///< reading the mesh and its textures, hashing them, packing it (store_mesh)
+  double upload_ms = 0.0;       ///< uploading the mesh to the renderer
+  double render_ms = 0.0;       ///< rendering the views
+  double extract_ms = 0.0;      ///< ECV primitives and the move into the object frame
+  double describe_ms = 0.0;     ///< context descriptors
+  double point_pairs_ms = 0.0;  ///< point pair points, and their table counted
 };
 
 struct BuildResult {

@@ -201,6 +201,7 @@ AddModelResult ModelDatabase::AddModel(const ModelRecord& record, const InsertPr
     if (progress) progress(static_cast<int>(v + 1), static_cast<int>(record.views.size()));
   }
   if (!record.mesh_blob.empty()) InsertMeshBlob(connection, model_id, record.mesh_blob);
+  if (record.point_pairs) detail::InsertPointPairs(connection, model_id, *record.point_pairs);
   if (kept_matrix) WriteColorMatrix(connection, model_id, *kept_matrix, kept_matrix->created);
   transaction.Commit();
   result.insert_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -268,7 +269,7 @@ ModelDbMigration MigrateModelDatabase(const std::string& path, const ModelDataba
   SqlConnection connection = OpenConnection(path, OpenMode::kReadWrite, options);
   const MigrationResult migrated = MigrateSchema(connection);
   UseWriteAheadLog(connection);
-  return {migrated.from_version, migrated.to_version, migrated.steps};
+  return {migrated.from_version, migrated.to_version, migrated.steps, migrated.notes};
 }
 
 }  // namespace ecv

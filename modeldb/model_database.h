@@ -108,6 +108,7 @@ struct ModelDbMigration {
   int from_version = 0;
   int to_version = 0;
   std::vector<std::string> steps;  ///< steps run, empty when the file was already current
+  std::vector<std::string> notes;  ///< what the steps could not do, one line each naming the model
 };
 
 /// Brings a library of an older schema to the current one in one transaction (all or nothing). Throws

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "modeldb/point_pair_record.h"
 #include "modeldb/schema.h"
 
 namespace ecv::detail {
@@ -172,7 +173,20 @@ ModelSummary ReadSummary(const SqlStatement& row, const std::string& path) {
   summary.has_color_matrix = row.Int(13) != 0;
   summary.mesh_blob_bytes = row.Int(14);
   summary.id = row.Int(15);
+  summary.point_pair_points = static_cast<int>(row.Int(16));
+  summary.point_pairs = row.Int(17);
+  summary.point_pair_refusal = row.Text(18);
   return summary;
+}
+
+void InsertPointPairs(SqlConnection& connection, int64_t model_id, const PointPairRecord& record) {
+  SqlStatement insert = connection.Prepare(
+      "INSERT INTO point_pairs (model_id, settings, num_points, num_pairs, points, refusal) VALUES (?, ?, ?, ?, ?, ?)");
+  const std::vector<unsigned char> points = EncodeOrientedPoints(record.points);
+  insert.Bind(1, model_id).Bind(2, PpfSamplingToJson(record.sampling));
+  insert.Bind(3, static_cast<int64_t>(record.points.size())).Bind(4, record.pairs);
+  insert.BindBlob(5, points.data(), points.size()).Bind(6, record.refusal);
+  insert.Run();
 }
 
 }  // namespace ecv::detail

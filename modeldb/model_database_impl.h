@@ -46,8 +46,14 @@ inline constexpr const char* kSummarySelect =
     "SELECT m.name, m.mesh_path, m.mesh_sha256, m.unit, m.object_from_mesh, m.diameter_m, m.symmetric, "
     "m.build_options, m.num_views, m.num_primitives, m.num_descriptors, m.descriptor_sha256, m.created, "
     "EXISTS (SELECT 1 FROM color_matrices c WHERE c.model_id = m.id), "
-    "coalesce((SELECT length(x.data) FROM meshes x WHERE x.model_id = m.id), 0), m.id FROM models m";
+    "coalesce((SELECT length(x.data) FROM meshes x WHERE x.model_id = m.id), 0), m.id, "
+    "coalesce((SELECT p.num_points FROM point_pairs p WHERE p.model_id = m.id), -1), "
+    "coalesce((SELECT p.num_pairs FROM point_pairs p WHERE p.model_id = m.id), 0), "
+    "coalesce((SELECT p.refusal FROM point_pairs p WHERE p.model_id = m.id), '') FROM models m";
 ModelSummary ReadSummary(const SqlStatement& row, const std::string& path);
+
+/// Stores a model's point pair points (schema version 3).
+void InsertPointPairs(SqlConnection& connection, int64_t model_id, const PointPairRecord& record);
 
 }  // namespace detail
 }  // namespace ecv

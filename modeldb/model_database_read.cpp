@@ -73,6 +73,21 @@ std::vector<ModelView> ReadViews(SqlConnection& connection, int64_t model_id, co
   return views;
 }
 
+std::optional<PointPairRecord> ReadPointPairs(SqlConnection& connection, int64_t model_id, const std::string& source) {
+  SqlStatement select =
+      connection.Prepare("SELECT settings, num_pairs, points, refusal FROM point_pairs WHERE model_id = ?");
+  select.Bind(1, model_id);
+  if (!select.Step()) return std::nullopt;
+  PointPairRecord record;
+  record.sampling = PpfSamplingFromJson(select.Text(0), source + ": point_pairs.settings");
+  record.pairs = select.Int(1);
+  size_t size = 0;
+  const auto* data = static_cast<const unsigned char*>(select.Blob(2, &size));
+  record.points = DecodeOrientedPoints(data, size, source + ": point_pairs.points");
+  record.refusal = select.Text(3);
+  return record;
+}
+
 ModelRecord ReadModel(SqlConnection& connection, const std::string& name, const FeatureSettings& features) {
   const int64_t id = RequireModelId(connection, name);
   SqlStatement select = connection.Prepare(std::string(kSummarySelect) + " WHERE m.id = ?");
@@ -98,6 +113,7 @@ ModelRecord ReadModel(SqlConnection& connection, const std::string& name, const 
     const auto* data = static_cast<const unsigned char*>(mesh.Blob(0, &size));
     record.mesh_blob.assign(data, data + size);
   }
+  record.point_pairs = ReadPointPairs(connection, id, connection.path() + ": model " + name);
   return record;
 }
 

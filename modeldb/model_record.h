@@ -10,6 +10,7 @@
 #include "core/mesh.h"
 #include "ecv/descriptor.h"
 #include "ecv/primitives.h"
+#include "modeldb/point_pair_record.h"
 
 namespace ecv {
 
@@ -60,6 +61,8 @@ struct ModelRecord {
   /// needs no mesh file; empty when not stored (a model of a schema-1 library, or built with store_mesh off):
   /// ModelMesh then reads mesh_path.
   std::vector<unsigned char> mesh_blob;
+  /// Its point pair points; nullopt when none were made (built without them, or migrated without a stored mesh).
+  std::optional<PointPairRecord> point_pairs;
 
   int NumPrimitives() const;
   int NumDescriptors() const;
@@ -111,7 +114,12 @@ struct ModelSummary {
   std::string descriptor_sha256;
   bool has_color_matrix = false;
   long long mesh_blob_bytes = 0;  ///< size of the stored mesh; 0 when the model reads its mesh file
-  std::string created;            ///< UTC time of storing, ISO 8601
+  /// Stored point pair points: -1 when none were made (built without them, or migrated without a stored mesh), 0
+  /// when the mesh was refused (point_pair_refusal says why).
+  int point_pair_points = -1;
+  long long point_pairs = 0;       ///< pairs in their table
+  std::string point_pair_refusal;  ///< why the mesh has no point pairs
+  std::string created;             ///< UTC time of storing, ISO 8601
 };
 
 }  // namespace ecv

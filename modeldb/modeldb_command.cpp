@@ -39,6 +39,7 @@ struct ModeldbArgs {
   std::string feature_settings;  // JSON file of FeatureSettings; empty: the defaults
   int threads = app::AllCores();
   bool no_stored_mesh = false;
+  bool no_point_pairs = false;
   int mesh_texture_size = MeshBlobOptions().max_texture_size;
   // list, info, remove, export, verify
   std::string model;
@@ -80,6 +81,7 @@ ModelBuildOptions BuildArguments(const ModeldbArgs& args) {
   options.render.shading = args.shading == "headlight" ? Shading::kHeadlight : Shading::kUnlit;
   options.shade_untextured = args.shading == "auto";
   options.store_mesh = !args.no_stored_mesh;
+  options.point_pairs = !args.no_point_pairs;
   options.mesh_blob.max_texture_size = args.mesh_texture_size;
   if (!args.feature_settings.empty()) {  // --feature-settings: e.g. {"descriptor": {"pairs": 1}}
     std::ifstream file(args.feature_settings);
@@ -128,7 +130,8 @@ LibraryBuildReporter BuildReporter(const ModelBuildOptions& options) {
     std::cerr << *prefix << ": stored " << built.record.views.size() << " views, " << built.record.NumPrimitives()
               << " primitives, " << built.record.NumDescriptors() << " descriptors (render "
               << Fixed(t.render_ms / 1000, 1) << " s, extract " << Fixed(t.extract_ms / 1000, 1) << " s, describe "
-              << Fixed(t.describe_ms / 1000, 1) << " s, insert " << Fixed(added.insert_ms / 1000, 1) << " s)"
+              << Fixed(t.describe_ms / 1000, 1) << " s, point pairs " << Fixed(t.point_pairs_ms / 1000, 1)
+              << " s, insert " << Fixed(added.insert_ms / 1000, 1) << " s)"
               << (built.record.mesh_blob.empty()
                       ? std::string(", mesh not stored")
                       : ", mesh stored (" + Fixed(built.record.mesh_blob.size() / 1e6, 1) + " MB)")
@@ -168,6 +171,20 @@ int RunBuild(const ModeldbArgs& args) {
   return summary.failed.empty() && scan.problems.empty() && !summary.built.empty() ? kExitOk : kExitBadInput;
 }
 
+// null when none were made; else the points and pairs, and the refusal of a mesh that has none.
+nlohmann::ordered_json PointPairsJson(const ModelSummary& m) {
+  if (m.point_pair_points < 0) return nullptr;
+  nlohmann::ordered_json json = {{"points", m.point_pair_points}, {"pairs", m.point_pairs}};
+  if (!m.point_pair_refusal.empty()) json["refusal"] = m.point_pair_refusal;
+  return json;
+}
+
+// The point pair column of `modeldb list`: the points stored, "refused" for a mesh without, "-" when none were made.
+std::string PointPairsColumn(const ModelSummary& m) {
+  if (m.point_pair_points < 0) return "-";
+  return m.point_pair_points == 0 ? "refused" : std::to_string(m.point_pair_points);
+}
+
 nlohmann::ordered_json SummaryJson(const ModelSummary& m) {
   return {{"name", m.name},
           {"id", m.id},
@@ -184,6 +201,7 @@ nlohmann::ordered_json SummaryJson(const ModelSummary& m) {
           {"descriptor_sha256", m.descriptor_sha256},
           {"color_matrix", m.has_color_matrix},
           {"stored_mesh_bytes", m.mesh_blob_bytes},
+          {"point_pairs", PointPairsJson(m)},
           {"build_options", nlohmann::json::parse(m.build_options_json, nullptr, false)},
           {"created", m.created}};
 }
@@ -199,13 +217,13 @@ int RunList(const ModeldbArgs& args) {
   }
   std::printf("%s: %zu models (schema version %d)\n", args.db.c_str(), models.size(), kModelDbSchemaVersion);
   if (models.empty()) return kExitOk;
-  std::printf("%-28s %6s %6s %11s %12s %12s %9s %7s %8s  %s\n", "name", "obj_id", "views", "primitives", "descriptors",
-              "diameter_mm", "symmetric", "colour", "mesh_MB", "created");
+  std::printf("%-28s %6s %6s %11s %12s %12s %9s %7s %8s %10s  %s\n", "name", "obj_id", "views", "primitives",
+              "descriptors", "diameter_mm", "symmetric", "colour", "mesh_MB", "ppf_points", "created");
   for (const ModelSummary& m : models) {
     const std::string mesh = m.mesh_blob_bytes > 0 ? Fixed(m.mesh_blob_bytes / 1e6, 1) : "file";  // not stored
-    std::printf("%-28s %6d %6d %11d %12d %12.1f %9s %7s %8s  %s\n", m.name.c_str(), BopObjectId(m.name, m.id),
+    std::printf("%-28s %6d %6d %11d %12d %12.1f %9s %7s %8s %10s  %s\n", m.name.c_str(), BopObjectId(m.name, m.id),
                 m.num_views, m.num_primitives, m.num_descriptors, 1000.0 * m.diameter_m, m.symmetric ? "yes" : "no",
-                m.has_color_matrix ? "yes" : "no", mesh.c_str(), m.created.c_str());
+                m.has_color_matrix ? "yes" : "no", mesh.c_str(), PointPairsColumn(m).c_str(), m.created.c_str());
   }
   return kExitOk;
 }
@@ -295,6 +313,7 @@ int RunMigrate(const ModeldbArgs& args) {
   for (const std::string& step : migration.steps) std::cout << "step " << step << '\n';
   std::cout << "migrated " << args.db << " from schema version " << migration.from_version << " to "
             << migration.to_version << '\n';
+  for (const std::string& note : migration.notes) std::cerr << "warning: " << args.db << ": " << note << '\n';
   return kExitOk;
 }
 
@@ -329,6 +348,9 @@ void AddBuildFlags(CLI::App& build, ModeldbArgs* args) {
       ->check(AtLeastOne());
   build.add_flag("--no-stored-mesh", args->no_stored_mesh,
                  "Do not store the meshes in the library: recognition then reads each mesh file (mesh_path)");
+  build.add_flag("--no-ppf", args->no_point_pairs,
+                 "Do not store point pair points: the models then get no shape-driven pose hypotheses "
+                 "(recognize --hypotheses ppf|both)");
   build
       .add_option("--mesh-texture-size", args->mesh_texture_size,
                   "Largest side of a stored mesh's textures, pixels (larger ones are downscaled; 0: as they are)")

@@ -1,6 +1,7 @@
 // The library's tables, the version check and the migration steps. Version 1 is the first released schema;
 // version 0 is the prototype layout (see kPrototypeTables) that step 0 -> 1 brings up to date; version 2 adds the
-// models' meshes (the table `meshes`), so that a library verifies its poses without the mesh files.
+// models' meshes (the table `meshes`), so that a library verifies its poses without the mesh files; version 3 adds
+// the models' point pair points (the table `point_pairs`).
 
 #include "modeldb/schema.h"
 
@@ -10,13 +11,16 @@
 
 #include "core/error.h"
 #include "core/version.h"
+#include "io/mesh_blob.h"
 #include "modeldb/content_hash.h"
+#include "modeldb/model_database_impl.h"
+#include "modeldb/point_pair_record.h"
 
 namespace ecv {
 namespace {
 
 // The ecvpose version that introduced each schema version (index = version), for the refusal of a newer file.
-const char* const kFirstEcvposeOfVersion[] = {"0.0 (prototype)", "0.1.0", "0.2.0"};
+const char* const kFirstEcvposeOfVersion[] = {"0.0 (prototype)", "0.1.0", "0.2.0", "0.3.0"};
 static_assert(sizeof(kFirstEcvposeOfVersion) / sizeof(kFirstEcvposeOfVersion[0]) == kModelDbSchemaVersion + 1,
               "name the ecvpose version that introduces each schema version");
 
@@ -85,6 +89,19 @@ CREATE TABLE meshes (
   data BLOB NOT NULL) STRICT;
 )sql";
 
+// Version 3: each model's point pair points (modeldb/point_pair_record.h): how they were drawn from the mesh
+// (settings, JSON), the points (num_points x 6 float32: position and normal), the pairs of their table, and, for a
+// mesh too small, flat or coarse for point pairs, the refusal (no points). A model without a row has none made.
+const char* const kPointPairsTable = R"sql(
+CREATE TABLE point_pairs (
+  model_id INTEGER PRIMARY KEY REFERENCES models(id) ON DELETE CASCADE,
+  settings TEXT NOT NULL,
+  num_points INTEGER NOT NULL CHECK (num_points >= 0),
+  num_pairs INTEGER NOT NULL CHECK (num_pairs >= 0),
+  points BLOB NOT NULL CHECK (length(points) = 24 * num_points),
+  refusal TEXT NOT NULL DEFAULT '') STRICT;
+)sql";
+
 // Tables of the prototype layout (user_version 0, no application id): models without the symmetric flag,
 // build options, counts and descriptor digest; no colour matrices; settings in a `settings` table.
 const std::vector<std::string> kPrototypeTables = {"descriptors", "models", "primitives", "settings", "views"};
@@ -115,7 +132,7 @@ void WriteVersionMeta(SqlConnection& connection) {
 
 // Step 0 -> 1: settings become meta, models gain the symmetric flag (0), build options, counts and the
 // descriptor digest; colour matrices appear.
-void MigrateFromPrototype(SqlConnection& connection) {
+std::vector<std::string> MigrateFromPrototype(SqlConnection& connection) {
   connection.Execute(kMetaAndColorTables);
   connection.Execute("INSERT INTO meta (key, value) SELECT key, value FROM settings; DROP TABLE settings;");
   connection.Execute(std::string(kModelsTable).replace(std::string(kModelsTable).find("models"), 6, "models_v1"));
@@ -139,11 +156,37 @@ ALTER TABLE models_v1 RENAME TO models;
     update.Bind(1, StoredDescriptorSha256(connection, ids.Int(0))).Bind(2, ids.Int(0));
     update.Run();
   }
+  return {};
 }
 
 // Step 1 -> 2: the meshes table, empty (models already stored keep reading their mesh files).
-void AddMeshesTable(SqlConnection& connection) {
+std::vector<std::string> AddMeshesTable(SqlConnection& connection) {
   connection.Execute(kMeshesTable);
+  return {};
+}
+
+// Step 2 -> 3: the point pairs table, with the points of every model whose mesh is stored, drawn from it with
+// today's defaults. A model that reads its mesh file gets none: its file may have changed since the build.
+std::vector<std::string> AddPointPairs(SqlConnection& connection) {
+  connection.Execute(kPointPairsTable);
+  std::vector<std::string> notes;
+  SqlStatement models = connection.Prepare(
+      "SELECT m.id, m.name, x.data FROM models m LEFT JOIN meshes x ON x.model_id = m.id ORDER BY m.name");
+  while (models.Step()) {
+    const std::string name = models.Text(1);
+    size_t size = 0;
+    const auto* data = static_cast<const unsigned char*>(models.Blob(2, &size));
+    if (size == 0) {
+      notes.push_back("model " + name + ": no stored mesh, so no point pair points; build it again " +
+                      "(`ecvpose modeldb build MESH --name " + name + " --db " + connection.path() + "`) to add them");
+      continue;
+    }
+    const PointPairRecord record =
+        MakePointPairRecord(DecodeMeshBlob(data, size, connection.path() + ": model " + name + ": stored mesh", false));
+    if (!record.refusal.empty()) notes.push_back("model " + name + ": no point pair points: " + record.refusal);
+    detail::InsertPointPairs(connection, models.Int(0), record);
+  }
+  return notes;
 }
 
 }  // namespace
@@ -193,6 +236,7 @@ void CreateSchema(SqlConnection& connection) {
   connection.Execute(kViewTables);
   connection.Execute(kMetaAndColorTables);
   connection.Execute(kMeshesTable);
+  connection.Execute(kPointPairsTable);
   WriteVersionMeta(connection);
   transaction.Commit();
 }
@@ -203,6 +247,8 @@ const std::vector<MigrationStep>& MigrationSteps() {
        MigrateFromPrototype},
       {1, "1 -> 2: a table for the models' meshes (models stored before keep reading their mesh files)",
        AddMeshesTable},
+      {2, "2 -> 3: the models' point pair points, drawn from their stored meshes (shape-driven pose hypotheses)",
+       AddPointPairs},
   };
   return steps;
 }
@@ -225,8 +271,9 @@ MigrationResult MigrateSchema(SqlConnection& connection) {
       if (step == steps.end())
         ThrowInputError(connection.path(), "schema version", "a version with a migration step",
                         std::to_string(version));
-      step->apply(connection);
+      const std::vector<std::string> notes = step->apply(connection);
       result.steps.push_back(step->description);
+      result.notes.insert(result.notes.end(), notes.begin(), notes.end());
     }
     if (connection.Prepare("PRAGMA foreign_key_check").Step()) {
       ThrowInputError(connection.path(), "foreign keys", "every view, primitive and descriptor to have its owner");

@@ -9,7 +9,7 @@
 namespace ecv {
 
 /// Schema version this ecvpose writes and reads (SQLite `PRAGMA user_version`).
-inline constexpr int kModelDbSchemaVersion = 2;
+inline constexpr int kModelDbSchemaVersion = 3;
 
 /// `PRAGMA application_id` of an ecvpose model library ("ECVP").
 inline constexpr int kModelDbApplicationId = 0x45435650;
@@ -37,11 +37,11 @@ SchemaState InspectSchema(SqlConnection& connection);
 void CreateSchema(SqlConnection& connection);
 
 /// One migration step: brings a library of `from_version` to `from_version + 1` (inside the caller's
-/// transaction).
+/// transaction); returns what the user should know of what it could not do, one line each.
 struct MigrationStep {
   int from_version;
   const char* description;
-  void (*apply)(SqlConnection& connection);
+  std::vector<std::string> (*apply)(SqlConnection& connection);
 };
 
 /// The migration steps, oldest first.
@@ -52,6 +52,7 @@ struct MigrationResult {
   int from_version = 0;
   int to_version = 0;
   std::vector<std::string> steps;  ///< descriptions of the steps run (empty when already current)
+  std::vector<std::string> notes;  ///< what the steps could not do, e.g. a model left without point pair points
 };
 
 /// Runs every step from the database's version to the current one in ONE transaction (all or nothing),

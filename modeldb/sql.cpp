@@ -227,7 +227,12 @@ SqlStatement& SqlStatement::Bind(int index, const std::string& value) {
 }
 
 SqlStatement& SqlStatement::BindBlob(int index, const void* data, size_t size) {
-  impl_->Check(sqlite3_bind_blob64(impl_->statement, index, data, size, SQLITE_TRANSIENT));
+  // An empty vector's data() may be null, which SQLite would bind as NULL instead of an empty blob.
+  if (size == 0) {
+    impl_->Check(sqlite3_bind_zeroblob(impl_->statement, index, 0));
+  } else {
+    impl_->Check(sqlite3_bind_blob64(impl_->statement, index, data, size, SQLITE_TRANSIENT));
+  }
   return *this;
 }
 

@@ -62,7 +62,9 @@ class Recognizer::Impl {
         meshes[i] = ModelMesh(models[first + i].record);
         records_[first + i].mesh_blob = {};  // the copy's bytes: the renderer holds the mesh
         closed[first + i] = meshes[i].IsClosedOutward() ? 1 : 0;
-        if (point_pairs) ppf_models_[first + i] = MakePointPairModel(meshes[i], &ppf_refusals_[first + i]);
+        if (point_pairs) {
+          ppf_models_[first + i] = MakePointPairModel(models[first + i].record, meshes[i], &ppf_refusals_[first + i]);
+        }
       });
       for (const TriangleMesh& mesh : meshes) meshes_.push_back(renderer_.AddMesh(mesh));
     }
@@ -250,12 +252,27 @@ class Recognizer::Impl {
     return best;
   }
 
-  // A model's point pair table from its mesh; none (the model gets no point pair hypotheses; `refusal` says why)
-  // when the mesh is too small, flat or coarse for point pairs.
-  std::optional<PpfModel> MakePointPairModel(const TriangleMesh& mesh, std::string* refusal) const {
+  // A model's point pair table: of its stored points when they were drawn as the options draw them, else of points
+  // drawn from its mesh now; none (`refusal` says why) when the library holds no points for it or its mesh is too
+  // small, flat or coarse for point pairs.
+  std::optional<PpfModel> MakePointPairModel(const ModelRecord& record, const TriangleMesh& mesh,
+                                             std::string* refusal) const {
+    if (!record.point_pairs) {
+      *refusal =
+          "the library holds no point pair points for it: built with --no-ppf, or migrated without a stored "
+          "mesh; build the model again to add them";
+      return std::nullopt;
+    }
+    const PpfOptions& options = options_.point_pairs.ppf;
+    const bool stored =
+        record.point_pairs->sampling == PpfModelSampling::Of(options, options_.point_pairs.model_samples);
+    if (stored && !record.point_pairs->refusal.empty()) {
+      *refusal = record.point_pairs->refusal;
+      return std::nullopt;
+    }
     try {
-      return PpfModel(SampleMeshSurface(mesh, options_.point_pairs.model_samples), mesh.Diameter(),
-                      options_.point_pairs.ppf);
+      if (stored) return PpfModel::FromSampledPoints(record.point_pairs->points, mesh.Diameter(), options);
+      return PpfModel(SampleMeshSurface(mesh, options_.point_pairs.model_samples), mesh.Diameter(), options);
     } catch (const InputError& error) {
       *refusal = error.what();
       return std::nullopt;
@@ -270,7 +287,10 @@ class Recognizer::Impl {
       if ((*models)[m].search && (*models)[m].instances.empty() && ppf_models_[m]) wanted.push_back(m);
     }
     if (wanted.empty()) return;
-    const std::vector<OrientedPoint> points = OrientedScenePoints(scene.organized);
+    const std::vector<OrientedPoint> points =
+        options_.point_pairs.remove_plane
+            ? WithoutDominantPlane(OrientedScenePoints(scene.organized), options_.point_pairs.plane)
+            : OrientedScenePoints(scene.organized);
     std::vector<StageTimes> model_times(wanted.size());
     ParallelFor(wanted.size(), options_.ransac.threads, [&](size_t i) {
       std::optional<Verified> best = BestPointPairPose(wanted[i], scene, points, &model_times[i]);

@@ -44,13 +44,6 @@ HypothesisSource ParseHypothesisSource(const std::string& name, const std::strin
   ThrowInputError(what, "hypotheses", "context, ppf or both", "'" + name + "'");
 }
 
-PpfOptions PointPairOptions::DefaultPpf() {
-  PpfOptions options;
-  options.coplanar_deg = 12.0;   // a table top's pairs neither go into the tables nor vote
-  options.spread_margin = 0.15;  // votes also in the neighbouring bin within 0.15 of a bin border
-  return options;
-}
-
 void RecognizerOptions::Check() const {
   match.Check();
   ransac.Check();
@@ -58,6 +51,7 @@ void RecognizerOptions::Check() const {
   verify.Check();
   ranking.consistency.Check();
   point_pairs.ppf.Check();
+  point_pairs.plane.Check();
   auto require = [](bool ok, const char* field, const char* expected) {
     if (!ok) ThrowInputError("recognizer options", field, expected);
   };

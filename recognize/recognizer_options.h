@@ -54,11 +54,15 @@ HypothesisSource ParseHypothesisSource(const std::string& name, const std::strin
 /// dense_stride_px), the best pose clusters refined by ICP and verified as the context's poses are.
 struct PointPairOptions {
   HypothesisSource source = HypothesisSource::kContext;
-  PpfOptions ppf = DefaultPpf();
-  int clusters = 5;           ///< the best pose clusters refined and verified per model
-  int model_samples = 20000;  ///< points spread over a model's mesh before sub-sampling
-
-  static PpfOptions DefaultPpf();
+  PpfOptions ppf;
+  /// The scene's dominant plane (a table top) is left out of the voting when it holds at least min_share of the
+  /// scene's points (remove_plane false: never).
+  bool remove_plane = true;
+  ScenePlaneOptions plane;
+  int clusters = 5;  ///< the best pose clusters refined and verified per model
+  /// Points spread over a model's mesh before sub-sampling. A library's stored points are used when they were drawn
+  /// alike (PpfModelSampling); otherwise the model's points are drawn from its mesh when the recognizer loads.
+  int model_samples = PpfModelSampling().samples;
 };
 
 /// Settings of the online recognizer (paper Sect. III and IV-C, and what goes beyond it). bench/RESULTS.md,

@@ -27,6 +27,7 @@ camera, size: the views' 3x3 intrinsics (default: YCB-Video's) and (width, heigh
 shading: "auto", "unlit" or "headlight".
 threads: worker threads (0: every core); the library is the same for any count.
 stored_mesh, mesh_texture_size: store each mesh in the library (textures at most this many pixels a side).
+point_pairs: store each model's point pair points (shape-driven hypotheses; False: as `--no-ppf`).
 feature_settings: a dict of extraction and descriptor settings as `ecvpose modeldb info` shows them.
 progress: called as progress(model, view, views) after each view.
 

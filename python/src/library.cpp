@@ -62,6 +62,7 @@ struct BuildArguments {
   std::string shading = "auto";
   int threads = 0;  // 0: every core
   bool stored_mesh = true;
+  bool point_pairs = true;
   int mesh_texture_size = MeshBlobOptions().max_texture_size;
   py::object feature_settings;  // None or a dict as `modeldb info` shows them
 };
@@ -88,6 +89,7 @@ ModelBuildOptions BuildOptions(const BuildArguments& args) {
   options.render.shading = args.shading == "headlight" ? Shading::kHeadlight : Shading::kUnlit;
   options.shade_untextured = args.shading == "auto";
   options.store_mesh = args.stored_mesh;
+  options.point_pairs = args.point_pairs;
   options.mesh_blob.max_texture_size = args.mesh_texture_size;
   if (!args.feature_settings.is_none()) {
     const std::string text = py::module_::import("json").attr("dumps")(args.feature_settings).cast<std::string>();
@@ -185,7 +187,7 @@ void BindLibrary(py::module_& m) {
       [](const std::string& db, const py::object& meshes, std::optional<std::string> name, std::string unit,
          py::object object_from_mesh, bool symmetric, bool allow_missing_textures, int views, double distance,
          py::object camera, std::pair<int, int> size, std::string shading, int threads, bool stored_mesh,
-         int mesh_texture_size, py::object feature_settings, py::object progress) {
+         bool point_pairs, int mesh_texture_size, py::object feature_settings, py::object progress) {
         const std::vector<std::string> paths = py::isinstance<py::str>(meshes)
                                                    ? std::vector<std::string>{meshes.cast<std::string>()}
                                                    : meshes.cast<std::vector<std::string>>();
@@ -202,6 +204,7 @@ void BindLibrary(py::module_& m) {
         args.shading = std::move(shading);
         args.threads = threads;
         args.stored_mesh = stored_mesh;
+        args.point_pairs = point_pairs;
         args.mesh_texture_size = mesh_texture_size;
         args.feature_settings = std::move(feature_settings);
         return BuildModels(db, paths, args, progress);
@@ -211,8 +214,9 @@ void BindLibrary(py::module_& m) {
       py::arg("views") = ModelBuildOptions::DefaultSampling().num_views,
       py::arg("distance") = ModelBuildOptions().distance_m, py::arg("camera") = py::none(),
       py::arg("size") = std::pair<int, int>{640, 480}, py::arg("shading") = "auto", py::arg("threads") = 0,
-      py::arg("stored_mesh") = true, py::arg("mesh_texture_size") = MeshBlobOptions().max_texture_size,
-      py::arg("feature_settings") = py::none(), py::arg("progress") = py::none(), kBuildModelsDoc);
+      py::arg("stored_mesh") = true, py::arg("point_pairs") = true,
+      py::arg("mesh_texture_size") = MeshBlobOptions().max_texture_size, py::arg("feature_settings") = py::none(),
+      py::arg("progress") = py::none(), kBuildModelsDoc);
 
   m.def(
       "render",

@@ -8,6 +8,7 @@
 #include <random>
 #include <string>
 #include <unordered_map>
+#include <utility>
 
 #include "core/error.h"
 #include "registration/icp.h"
@@ -304,11 +305,93 @@ std::vector<OrientedPoint> OrientedScenePoints(const OrganizedScene& organized) 
   return points;
 }
 
+void ScenePlaneOptions::Check() const {
+  auto require = [](bool ok, const char* field, const char* expected) {
+    if (!ok) ThrowInputError("scene plane options", field, expected);
+  };
+  require(distance_m > 0.0, "distance_m", "> 0 m");
+  require(normal_deg > 0.0 && normal_deg <= 90.0, "normal_deg", "in (0, 90] degrees");
+  require(min_share > 0.0 && min_share <= 1.0, "min_share", "in (0, 1]");
+  require(iterations >= 1, "iterations", "at least 1");
+}
+
+std::vector<OrientedPoint> WithoutDominantPlane(const std::vector<OrientedPoint>& points,
+                                                const ScenePlaneOptions& options) {
+  options.Check();
+  if (points.size() < 3) return points;
+  const float distance = static_cast<float>(options.distance_m);
+  const float min_cosine = static_cast<float>(std::cos(options.normal_deg * kPi / 180.0));
+  auto on_plane = [&](const OrientedPoint& point, const Eigen::Vector3f& normal, float offset) {
+    return std::abs(normal.dot(point.position) + offset) <= distance &&
+           std::abs(normal.dot(point.normal)) >= min_cosine;
+  };
+  // Planes are scored on at most 4000 of the points, spread evenly; the best one then takes its points from all.
+  const size_t step = std::max<size_t>(1, points.size() / 4000);
+  std::mt19937 random(1);
+  std::uniform_int_distribution<size_t> pick(0, points.size() - 1);
+  Eigen::Vector3f best_normal = Eigen::Vector3f::Zero();
+  float best_offset = 0.0F;
+  size_t best_count = 0;
+  for (int i = 0; i < options.iterations; ++i) {
+    const Eigen::Vector3f& a = points[pick(random)].position;
+    const Eigen::Vector3f& b = points[pick(random)].position;
+    const Eigen::Vector3f& c = points[pick(random)].position;
+    const Eigen::Vector3f normal = (b - a).cross(c - a);
+    if (normal.norm() < 1e-9F) continue;
+    const Eigen::Vector3f unit = normal.normalized();
+    const float offset = -unit.dot(a);
+    size_t count = 0;
+    for (size_t k = 0; k < points.size(); k += step) count += on_plane(points[k], unit, offset) ? 1 : 0;
+    if (count > best_count) best_count = count, best_normal = unit, best_offset = offset;
+  }
+  const size_t sampled = (points.size() + step - 1) / step;
+  if (best_count == 0 || static_cast<double>(best_count) < options.min_share * static_cast<double>(sampled)) {
+    return points;
+  }
+  std::vector<OrientedPoint> kept;
+  kept.reserve(points.size());
+  for (const OrientedPoint& point : points) {
+    if (!on_plane(point, best_normal, best_offset)) kept.push_back(point);
+  }
+  return kept;
+}
+
+PpfModelSampling PpfModelSampling::Of(const PpfOptions& options, int samples) {
+  return {samples, options.sampling, options.keep_normal_deg};
+}
+
+bool PpfModelSampling::operator==(const PpfModelSampling& other) const {
+  return samples == other.samples && sampling == other.sampling && keep_normal_deg == other.keep_normal_deg;
+}
+
+void PpfModelSampling::Check() const {
+  auto require = [](bool ok, const char* field, const char* expected) {
+    if (!ok) ThrowInputError("point pair sampling", field, expected);
+  };
+  require(samples >= 10 && samples <= 10000000, "samples", "10 to 10 000 000 points");
+  require(sampling > 0.0 && sampling < 1.0, "sampling", "a share of the diameter in (0, 1)");
+  require(keep_normal_deg > 0.0 && keep_normal_deg <= 180.0, "keep_normal_deg", "in (0, 180] degrees");
+}
+
+std::vector<OrientedPoint> SampleModelPoints(const TriangleMesh& mesh, const PpfModelSampling& sampling) {
+  sampling.Check();
+  return SubsampleByNormals(SampleMeshSurface(mesh, sampling.samples), sampling.sampling * mesh.Diameter(),
+                            sampling.keep_normal_deg);
+}
+
 PpfModel::PpfModel(const std::vector<OrientedPoint>& surface, double diameter_m, const PpfOptions& options)
+    : PpfModel(surface, diameter_m, options, false) {}
+
+PpfModel PpfModel::FromSampledPoints(std::vector<OrientedPoint> points, double diameter_m, const PpfOptions& options) {
+  return PpfModel(std::move(points), diameter_m, options, true);
+}
+
+PpfModel::PpfModel(std::vector<OrientedPoint> points, double diameter_m, const PpfOptions& options, bool sampled)
     : diameter_m_(diameter_m), options_(options) {
   options.Check();
   if (!(diameter_m > 0.0)) ThrowInputError("point pair model", "diameter_m", "> 0 m", std::to_string(diameter_m));
-  points_ = SubsampleByNormals(surface, options.sampling * diameter_m, options.keep_normal_deg);
+  points_ =
+      sampled ? std::move(points) : SubsampleByNormals(points, options.sampling * diameter_m, options.keep_normal_deg);
   if (points_.size() < 10) {
     ThrowInputError("point pair model", "surface", "at least 10 points after sub-sampling",
                     std::to_string(points_.size()));

@@ -30,14 +30,14 @@ struct PpfOptions {
   double scene_keep_normal_deg = 30.0;
   int scene_reference_step = 5;     ///< every n-th sub-sampled scene point is a reference point
   bool spread_votes = true;         ///< also look up the neighbouring bin of each feature value near a bin border
-  double spread_margin = 0.5;       ///< ... "near": within this share of a bin from the border (0.5: always)
+  double spread_margin = 0.15;      ///< ... "near": within this share of a bin from the border (0.5: always)
   int poses_per_reference = 3;      ///< the best poses of each reference point kept for clustering
   double cluster_distance = 0.1;    ///< poses closer than this (share of the diameter) ...
   double cluster_angle_deg = 30.0;  ///< ... and turned less than this join one cluster
   int max_poses = 20;               ///< clusters returned, most votes first
   /// Pairs of one plane (normals within this and both at 90 +- this degrees to the line between them) neither go
   /// into the table nor vote (0: all pairs): a table top or a box face alone gives thousands of them, all alike.
-  double coplanar_deg = 0.0;
+  double coplanar_deg = 12.0;
 
   /// Throws InputError on values outside their ranges.
   void Check() const;
@@ -58,13 +58,51 @@ std::vector<OrientedPoint> OrientedScenePoints(const RgbdFrame& frame, int strid
 /// The same of depth samples made already.
 std::vector<OrientedPoint> OrientedScenePoints(const OrganizedScene& organized);
 
+/// How a model's point pair points are drawn from its mesh. A library stores them with these settings; the
+/// recognizer uses them when its PpfOptions sub-sample alike (FitsOptions).
+struct PpfModelSampling {
+  int samples = 20000;            ///< points spread over the mesh by area (SampleMeshSurface, seed 1) ...
+  double sampling = 0.05;         ///< ... then sub-sampled so (PpfOptions::sampling, share of the diameter)
+  double keep_normal_deg = 30.0;  ///< PpfOptions::keep_normal_deg
+
+  /// The settings that `options` sub-sample a model with, `samples` points spread before.
+  static PpfModelSampling Of(const PpfOptions& options, int samples);
+  bool operator==(const PpfModelSampling& other) const;
+
+  /// Throws InputError on values outside their ranges.
+  void Check() const;
+};
+
+/// A model's point pair points (object frame, metres): its mesh sampled and sub-sampled as `sampling` says.
+std::vector<OrientedPoint> SampleModelPoints(const TriangleMesh& mesh, const PpfModelSampling& sampling);
+
+/// The largest plane of a scene (a table top, a floor), found by RANSAC on oriented points.
+struct ScenePlaneOptions {
+  double distance_m = 0.01;  ///< a point lies on the plane within this, metres ...
+  double normal_deg = 25.0;  ///< ... with its normal within this of the plane's
+  double min_share = 0.2;    ///< a plane is dominant when it holds at least this share of the points
+  int iterations = 200;      ///< planes tried (seeded: the same points give the same plane)
+
+  /// Throws InputError on values outside their ranges.
+  void Check() const;
+};
+
+/// `points` without those of their dominant plane (ScenePlaneOptions), or all of them when no plane is. Pairs with a
+/// table top's points describe no object on it, and they are most of a frame's points.
+std::vector<OrientedPoint> WithoutDominantPlane(const std::vector<OrientedPoint>& points,
+                                                const ScenePlaneOptions& options = {});
+
 /// A model's point pair table: every ordered pair of its sub-sampled points by quantized feature.
 class PpfModel {
  public:
-  /// From the model's surface points (object frame) and its diameter (metres); throws InputError when fewer than
-  /// 10 points remain after sub-sampling or fewer than 100 pairs go into the table (a mesh too small, flat or
-  /// coarse for point pairs).
+  /// From the model's surface points (object frame) and its diameter (metres), sub-sampled as `options` say; throws
+  /// InputError when fewer than 10 points remain or fewer than 100 pairs go into the table (a mesh too small, flat
+  /// or coarse for point pairs).
   PpfModel(const std::vector<OrientedPoint>& surface, double diameter_m, const PpfOptions& options = {});
+
+  /// From points sub-sampled already (SampleModelPoints, or a library's stored ones); the same refusals.
+  static PpfModel FromSampledPoints(std::vector<OrientedPoint> points, double diameter_m,
+                                    const PpfOptions& options = {});
 
   const std::vector<OrientedPoint>& points() const { return points_; }
   double diameter_m() const { return diameter_m_; }
@@ -85,6 +123,8 @@ class PpfModel {
   }
 
  private:
+  PpfModel(std::vector<OrientedPoint> points, double diameter_m, const PpfOptions& options, bool sampled);
+
   std::vector<OrientedPoint> points_;
   double diameter_m_;
   PpfOptions options_;

@@ -1,6 +1,7 @@
 // The model database on synthetic models (no rendering): storing and loading bit for bit, atomic replacement,
 // removal, colour matrices, feature settings, verification, bad files, schema versions and migration.
 
+#include <cmath>
 #include <fstream>
 #include <string>
 
@@ -320,6 +321,55 @@ TEST(ModelDatabase, NamesWhatIsWrongWithABadFile) {
             "");
 }
 
+// Point pair points round-trip bit for bit, with their sampling, pairs and a refusal; a model built without them
+// has none; stored points that are not oriented points are refused naming the model.
+TEST(ModelDatabase, StoresPointPairPointsBitForBit) {
+  test::TemporaryDirectory directory;
+  const std::string path = directory.File("lib.sqlite");
+  ModelRecord with = test::SyntheticModel("with", 1, 10, 1), refused = test::SyntheticModel("refused", 1, 10, 2);
+  PointPairRecord points;
+  points.sampling.samples = 1234;
+  points.sampling.keep_normal_deg = 25.0;
+  for (int i = 0; i < 50; ++i) {
+    const float t = 0.37F * static_cast<float>(i);
+    points.points.push_back({{std::sin(t) / 7.0F, std::cos(t) / 3.0F, t / 1000.0F},
+                             Eigen::Vector3f(std::cos(t), 0.3F, std::sin(t)).normalized()});
+  }
+  points.pairs = 2450;
+  with.point_pairs = points;
+  refused.point_pairs = PointPairRecord{};
+  refused.point_pairs->refusal = "too flat";
+  ModelDatabase database(path, OpenMode::kCreate);
+  database.AddModel(with);
+  database.AddModel(refused);
+  database.AddModel(test::SyntheticModel("without", 1, 10, 3));
+
+  const std::vector<StoredModel> loaded = database.LoadModels();
+  ASSERT_EQ(loaded.size(), 3U);
+  const std::optional<PointPairRecord>& read = loaded[1].record.point_pairs;  // by name: refused, with, without
+  ASSERT_TRUE(read.has_value());
+  EXPECT_EQ(read->sampling, points.sampling);
+  EXPECT_EQ(read->pairs, 2450);
+  ASSERT_EQ(read->points.size(), points.points.size());
+  EXPECT_EQ(EncodeOrientedPoints(read->points), EncodeOrientedPoints(points.points));
+  ASSERT_TRUE(loaded[0].record.point_pairs.has_value());
+  EXPECT_TRUE(loaded[0].record.point_pairs->points.empty());
+  EXPECT_EQ(loaded[0].record.point_pairs->refusal, "too flat");
+  EXPECT_FALSE(loaded[2].record.point_pairs.has_value());
+  const std::vector<ModelSummary> summaries = database.ListModels();
+  EXPECT_EQ(summaries[0].point_pair_points, 0);
+  EXPECT_EQ(summaries[1].point_pair_points, 50);
+  EXPECT_EQ(summaries[1].point_pairs, 2450);
+  EXPECT_EQ(summaries[2].point_pair_points, -1);
+
+  SqlConnection(path, SqlOpenMode::kReadWrite, 1000)
+      .Execute(
+          "UPDATE point_pairs SET points = zeroblob(24), num_points = 1 WHERE model_id = "
+          "(SELECT id FROM models WHERE name = 'with')");
+  EXPECT_THAT(InputErrorOf([&] { database.LoadModels({"with"}); }),
+              AllOf(HasSubstr("model with"), HasSubstr("point_pairs.points"), HasSubstr("unit normal")));
+}
+
 TEST(ModelDatabase, RefusesANewerSchemaNamingTheVersionNeeded) {
   test::TemporaryDirectory directory;
   const std::string path = directory.File("lib.sqlite");
@@ -329,9 +379,10 @@ TEST(ModelDatabase, RefusesANewerSchemaNamingTheVersionNeeded) {
     raw.Execute("PRAGMA user_version = 7; UPDATE meta SET value = '0.9.0' WHERE key = 'min_ecvpose_version'");
   }
   for (const OpenMode mode : {OpenMode::kReadOnly, OpenMode::kReadWrite, OpenMode::kCreate}) {
-    EXPECT_THAT(InputErrorOf([&] { ModelDatabase(path, mode); }),
-                AllOf(HasSubstr(path), HasSubstr("schema version 7"), HasSubstr("up to 2"),
-                      HasSubstr("ecvpose 0.9.0 or newer")));
+    EXPECT_THAT(
+        InputErrorOf([&] { ModelDatabase(path, mode); }),
+        AllOf(HasSubstr(path), HasSubstr("schema version 7"),
+              HasSubstr("up to " + std::to_string(kModelDbSchemaVersion)), HasSubstr("ecvpose 0.9.0 or newer")));
   }
   EXPECT_THAT(InputErrorOf([&] { MigrateModelDatabase(path); }), HasSubstr("schema version 7"));
 }
@@ -349,7 +400,11 @@ TEST(ModelDatabase, MigratesThePrototypeLayoutInOneTransaction) {
   const ModelDbMigration migration = MigrateModelDatabase(path);
   EXPECT_EQ(migration.from_version, 0);
   EXPECT_EQ(migration.to_version, kModelDbSchemaVersion);
-  EXPECT_EQ(migration.steps.size(), 2U);                  // 0 -> 1 -> 2
+  EXPECT_EQ(migration.steps.size(), 3U);  // 0 -> 1 -> 2 -> 3
+  // Without stored meshes the models get no point pair points, and the migration says so, naming them.
+  ASSERT_EQ(migration.notes.size(), 2U);
+  EXPECT_THAT(migration.notes[0], AllOf(HasSubstr("model a"), HasSubstr("no stored mesh"), HasSubstr("build")));
+  EXPECT_THAT(migration.notes[1], HasSubstr("model b"));
   EXPECT_TRUE(MigrateModelDatabase(path).steps.empty());  // nothing left to do
 
   ModelDatabase database(path, OpenMode::kReadWrite);
@@ -378,16 +433,18 @@ TEST(ModelDatabase, MigratesAVersionOneLibraryByAddingTheMeshesTable) {
   ModelDatabase(path, OpenMode::kCreate).AddModel(a);
   SqlConnection(path, SqlOpenMode::kReadWrite, 1000)
       .Execute(
-          "DROP TABLE meshes; PRAGMA user_version = 1; UPDATE meta SET value = '0.1.0' WHERE key = "
+          "DROP TABLE meshes; DROP TABLE point_pairs; PRAGMA user_version = 1; UPDATE meta SET value = '0.1.0' "
+          "WHERE key = "
           "'min_ecvpose_version'");
   EXPECT_THAT(InputErrorOf([&] { ModelDatabase(path, OpenMode::kReadOnly); }),
               AllOf(HasSubstr("schema version 1"), HasSubstr("ecvpose modeldb migrate --db " + path)));
 
   const ModelDbMigration migration = MigrateModelDatabase(path);
   EXPECT_EQ(migration.from_version, 1);
-  EXPECT_EQ(migration.to_version, 2);
-  ASSERT_EQ(migration.steps.size(), 1U);
+  EXPECT_EQ(migration.to_version, 3);
+  ASSERT_EQ(migration.steps.size(), 2U);
   EXPECT_THAT(migration.steps[0], HasSubstr("meshes"));
+  EXPECT_THAT(migration.steps[1], HasSubstr("point pair"));
   ModelDatabase database(path, OpenMode::kReadWrite);
   EXPECT_TRUE(database.Verify().ok());
   const std::vector<StoredModel> loaded = database.LoadModels();

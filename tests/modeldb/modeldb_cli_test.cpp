@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include <gmock/gmock.h>
@@ -268,6 +269,45 @@ TEST_F(ModeldbCli, AMeshOfAnImplausibleSizeNamesTheUnit) {
   }
 }
 
+// Meshes with no relief for point pairs (one triangle, a flat square) are stored without point pair points, each
+// named in a warning, exit 0; `--no-ppf` stores none; `list` tells the three apart, and `recognize --hypotheses ppf`
+// names the models it has no point pairs for.
+TEST_F(ModeldbCli, MeshesWithoutReliefAreStoredWithoutPointPairsAndNamed) {
+  const std::string triangle = scratch_.File("triangle.obj"), square = scratch_.File("square.obj");
+  std::ofstream(triangle) << "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nf 1 2 3\n";
+  std::ofstream(square) << "v 0 0 0\nv 0.1 0 0\nv 0.1 0.1 0\nv 0 0.1 0\nf 1 2 3\nf 1 3 4\n";
+  const std::string library = scratch_.File("flat.sqlite");
+  const test::CommandResult build =
+      test::RunCli("modeldb build " + triangle + " " + square + " --db " + library + QuickFlags(4));
+  EXPECT_EQ(build.exit_code, 0) << build.output;
+  for (const std::string& mesh : {triangle, square}) {
+    EXPECT_THAT(build.output, HasSubstr("warning: " + mesh + ": no point pair points")) << build.output;
+  }
+  const std::string mustard = test::DemoMeshDirectory() + "/006_mustard_bottle";
+  const test::CommandResult skipped =
+      test::RunCli("modeldb build " + mustard + " --no-ppf --db " + library + QuickFlags(1));
+  EXPECT_EQ(skipped.exit_code, 0) << skipped.output;
+
+  std::map<std::string, int> points;
+  for (const ModelSummary& model : ModelDatabase(library, OpenMode::kReadOnly).ListModels()) {
+    points[model.name] = model.point_pair_points;
+    if (model.point_pair_points == 0) {
+      EXPECT_THAT(model.point_pair_refusal, HasSubstr("relief"));
+    }
+  }
+  EXPECT_EQ(points, (std::map<std::string, int>{{"006_mustard_bottle", -1}, {"square", 0}, {"triangle", 0}}));
+  const nlohmann::json listed = nlohmann::json::parse(test::RunCli("modeldb list --json --db " + library).output);
+  ASSERT_EQ(listed.size(), 3U);
+  EXPECT_TRUE(listed[0]["point_pairs"].is_null());
+  EXPECT_EQ(listed[1]["point_pairs"]["points"], 0);
+
+  const test::CommandResult recognized = test::RunCli("recognize --db " + library + " --hypotheses ppf --threads 2 " +
+                                                      std::string(ECV_SOURCE_DIR) + "/models/frame/000001");
+  EXPECT_EQ(recognized.exit_code, 0) << recognized.output;
+  EXPECT_THAT(recognized.output, AllOf(HasSubstr("model 006_mustard_bottle: no point pair hypotheses"),
+                                       HasSubstr("--no-ppf"), HasSubstr("model square: no point pair hypotheses")));
+}
+
 TEST_F(ModeldbCli, ReadsButDoesNotWriteInAReadOnlyLocation) {
   const fs::path read_only = scratch_.path() / "read_only";
   fs::create_directories(read_only);
@@ -325,7 +365,7 @@ TEST_F(ModeldbCli, RefusesFilesThatAreNotLibrariesOfThisVersion) {
   EXPECT_THAT(needs_migration.output, HasSubstr("run `ecvpose modeldb migrate --db " + old + "`"));
   const test::CommandResult migrated = test::RunCli("modeldb migrate --db " + old);
   EXPECT_EQ(migrated.exit_code, 0) << migrated.output;
-  EXPECT_THAT(migrated.output, HasSubstr("from schema version 0 to 2"));
+  EXPECT_THAT(migrated.output, HasSubstr("from schema version 0 to 3"));
   EXPECT_EQ(test::RunCli("modeldb list --db " + old).exit_code, 0);
 }
 

@@ -553,6 +553,63 @@ TEST_F(RecognizeEndToEnd, NeedsNoMeshFileAndVerifiesAsTheMeshFilesDo) {
   EXPECT_EQ(detections[0], detections[1]);
 }
 
+// Rows of `table` in the main database that the attached database `other` lacks, and the reverse: 0 when the two
+// tables hold the same rows, value for value (blobs byte for byte).
+int64_t RowsDiffering(SqlConnection& connection, const std::string& table, const std::string& other) {
+  SqlStatement count = connection.Prepare(
+      "SELECT (SELECT count(*) FROM (SELECT * FROM main." + table + " EXCEPT SELECT * FROM " + other + "." + table +
+      ")) + (SELECT count(*) FROM (SELECT * FROM " + other + "." + table + " EXCEPT SELECT * FROM main." + table +
+      ")) + abs((SELECT count(*) FROM main." + table + ") - (SELECT count(*) FROM " + other + "." + table + "))");
+  EXPECT_TRUE(count.Step());
+  return count.Int(0);
+}
+
+// A library of schema 2 (the demo library with its point pair points taken out) migrated to 3: every row it had is
+// kept as it was, and its models get the point pair points a fresh build stores, so point pairs alone find the same.
+TEST_F(RecognizeEndToEnd, AMigratedLibraryKeepsItsRowsAndGetsThePointPairsOfAFreshOne) {
+  const std::string before = directory_->File("schema2.sqlite"), migrated = directory_->File("migrated.sqlite");
+  std::filesystem::copy_file(library_, before);
+  SqlConnection(before, SqlOpenMode::kReadWrite, 1000)
+      .Execute(
+          "DROP TABLE point_pairs; PRAGMA user_version = 2; "
+          "UPDATE meta SET value = '0.2.0' WHERE key = 'min_ecvpose_version'");
+  std::filesystem::copy_file(before, migrated);
+  const test::CommandResult migrate = test::RunCli("modeldb migrate --db " + migrated);
+  ASSERT_EQ(migrate.exit_code, 0) << migrate.output;
+  EXPECT_THAT(migrate.output, ::testing::HasSubstr("from schema version 2 to 3"));
+
+  SqlConnection connection(migrated, SqlOpenMode::kReadOnly, 1000);
+  connection.Execute("ATTACH DATABASE '" + before + "' AS before; ATTACH DATABASE '" + library_ + "' AS fresh");
+  for (const char* table : {"models", "views", "primitives", "descriptors", "meshes", "color_matrices"}) {
+    EXPECT_EQ(RowsDiffering(connection, table, "before"), 0) << table;
+  }
+  EXPECT_EQ(RowsDiffering(connection, "point_pairs", "fresh"), 0);
+  SqlStatement points = connection.Prepare("SELECT count(*), min(num_points) FROM point_pairs");
+  ASSERT_TRUE(points.Step());
+  EXPECT_EQ(points.Int(0), 3);
+  EXPECT_GT(points.Int(1), 100);
+
+  RecognizerOptions options;
+  options.point_pairs.source = HypothesisSource::kPpf;
+  options.ransac.threads = 2;
+  const RgbdFrame frame = LoadYcbvFrame(Frame()).rgbd;
+  LibraryLoadOptions load;
+  load.build_matchers = false;
+  std::vector<Detection> found[2];
+  for (int i = 0; i < 2; ++i) {
+    const ModelLibrary library = ModelLibrary::Load(i == 0 ? library_ : migrated, load);
+    Recognizer recognizer(library, options);
+    EXPECT_TRUE(recognizer.PointPairWarnings().empty());
+    found[i] = recognizer.Recognize(frame).detections;
+  }
+  EXPECT_FALSE(found[0].empty());
+  ASSERT_EQ(found[0].size(), found[1].size());
+  for (size_t d = 0; d < found[0].size(); ++d) {
+    EXPECT_EQ(found[0][d].model, found[1][d].model);
+    EXPECT_TRUE(found[0][d].camera_from_object.isApprox(found[1][d].camera_from_object, 1e-12)) << found[0][d].model;
+  }
+}
+
 // A library built without its meshes reads them when a Recognizer is made (for verification renders), on worker
 // threads: a mesh file gone since the library was built is an error naming it, raised from whichever thread read it.
 TEST(RecognizeCli, AMeshFileGoneSinceALibraryWithoutMeshesWasBuiltIsNamed) {
