@@ -8,6 +8,7 @@ find_package(nlohmann_json 3 REQUIRED)
 find_package(CLI11 REQUIRED)
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(MATIO REQUIRED IMPORTED_TARGET matio)
+pkg_check_modules(ZLIB REQUIRED IMPORTED_TARGET zlib)
 pkg_check_modules(OSMESA REQUIRED IMPORTED_TARGET osmesa)
 # FLANN's C++ API is header-only; its serialisation needs lz4 linked explicitly.
 find_path(FLANN_INCLUDE_DIR flann/flann.hpp REQUIRED)

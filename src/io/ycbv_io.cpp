@@ -14,6 +14,7 @@
 
 #include "core/error.h"
 #include "io/frame_io.h"
+#include "io/mat_check.h"
 
 namespace ecv {
 namespace {
@@ -103,16 +104,8 @@ std::string YcbvClassName(int cls_index) {
 
 LoadedFrame LoadYcbvFrame(const std::string& prefix) {
   const std::string meta_path = prefix + "-meta.mat";
-  // YCB-Video's meta files are MAT-files of version 5 or later, which open with a text header ("MATLAB 5.0 MAT-file",
-  // "MATLAB 7.3 MAT-file"). Version 4 files have none, and matio sizes its reads of them from the file's counts alone
-  // (an 80-byte file took 2 GB): they are refused before matio sees them.
-  char header[6] = {};
-  std::ifstream stream(meta_path, std::ios::binary);
-  if (!stream.read(header, sizeof(header)) || std::string(header, sizeof(header)) != "MATLAB") {
-    ThrowInputError(meta_path, "meta", "a MATLAB MAT-file of version 5 or later (a text header \"MATLAB ...\")",
-                    stream ? "no such header" : "a file too short or unreadable");
-  }
-  stream.close();
+  // matio sizes its reads from the file's counts alone: the structure is checked first (io/mat_check.h).
+  CheckMatFile(meta_path);
   std::unique_ptr<mat_t, MatFileCloser> file(Mat_Open(meta_path.c_str(), MAT_ACC_RDONLY));
   if (!file) ThrowInputError(meta_path, "meta", "a readable MATLAB file (YCB-Video -meta.mat)");
 

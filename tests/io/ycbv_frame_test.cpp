@@ -7,6 +7,7 @@
 
 #include <matio.h>
 
+#include <fstream>
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
@@ -120,6 +121,53 @@ TEST(YcbvFrame, AVersion4MetaFileIsRefusedNamingTheVersion) {
   const std::string message = Refusal(prefix);
   EXPECT_NE(message.find("version 5 or later"), std::string::npos) << message;
   EXPECT_NE(message.find("no such header"), std::string::npos) << message;
+}
+
+// A version 5 meta file whose counts claim more than it holds (matio allocates by them: a 318-byte file found by
+// fuzzing asked for 4 GB) is refused before matio reads it, naming the file and the element.
+TEST(YcbvFrame, AMetaFileWhoseCountsExceedItIsRefusedBeforeMatioReadsIt) {
+  test::TemporaryDirectory directory;
+  const std::string prefix = CopyOfFrameImages(directory);
+  const std::string meta = prefix + "-meta.mat";
+  auto write = [&](matio_compression compression) {
+    mat_t* file = Mat_CreateVer(meta.c_str(), nullptr, MAT_FT_MAT5);
+    ASSERT_NE(file, nullptr);
+    size_t dims[2] = {1, 1};
+    double factor = 10000;
+    matvar_t* variable = Mat_VarCreate("factor_depth", MAT_C_DOUBLE, MAT_T_DOUBLE, 2, dims, &factor, 0);
+    Mat_VarWrite(file, variable, compression);
+    Mat_VarFree(variable);
+    Mat_Close(file);
+  };
+  auto patch = [&](size_t offset, std::vector<uint32_t> words) {
+    std::fstream file(meta, std::ios::in | std::ios::out | std::ios::binary);
+    file.seekp(static_cast<std::streamoff>(offset));
+    file.write(reinterpret_cast<const char*>(words.data()), static_cast<std::streamsize>(4 * words.size()));
+  };
+  // Uncompressed: the matrix's tag at byte 128, its array flags at 136, dimensions at 152, name at 168.
+  write(MAT_COMPRESSION_NONE);
+  patch(172, {0xffffff00U});
+  std::string message = Refusal(prefix);
+  EXPECT_NE(message.find(meta), std::string::npos) << message;
+  EXPECT_NE(message.find("element at byte 168"), std::string::npos) << message;
+  EXPECT_NE(message.find("4294967040 bytes"), std::string::npos) << message;
+  write(MAT_COMPRESSION_NONE);
+  patch(160, {100000, 100000});
+  message = Refusal(prefix);
+  EXPECT_NE(message.find("values in"), std::string::npos) << message;
+  write(MAT_COMPRESSION_NONE);
+  patch(132, {0x7fffffffU});
+  EXPECT_NE(Refusal(prefix).find("element at byte 128"), std::string::npos);
+  // Compressed: the deflate stream cut short by a wrong size, and broken inside.
+  write(MAT_COMPRESSION_ZLIB);
+  const uintmax_t size = std::filesystem::file_size(meta);
+  std::filesystem::resize_file(meta, size - 6);
+  patch(132, {static_cast<uint32_t>(size - 6 - 136)});
+  message = Refusal(prefix);
+  EXPECT_NE(message.find("does not inflate whole"), std::string::npos) << message;
+  write(MAT_COMPRESSION_ZLIB);
+  patch(144, {0xffffffffU, 0xffffffffU});
+  EXPECT_NE(Refusal(prefix).find("MAT-file element at byte 128"), std::string::npos);
 }
 
 // The check on 0001/000001: each object's origin projects onto its own label pixels.

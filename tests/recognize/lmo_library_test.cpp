@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "io/frame_io.h"
+#include "io/pose_io.h"
 #include "modeldb/model_library.h"
 #include "recognize/evaluation.h"
 #include "support/test_data.h"
@@ -14,7 +15,7 @@
 namespace ecv {
 namespace {
 
-TEST(LmoLibrary, FindsTheCanWithoutFalsePositives) {
+TEST(LmoLibrary, FindsTheCanAndWithPointPairsTheDuckWithoutFalsePositives) {
   const test::TemporaryDirectory directory;
   const std::string library = directory.File("lmo.sqlite");
   const std::string models = test::DataPath("lmo_subset/data/bop/lmo/models");
@@ -61,6 +62,32 @@ TEST(LmoLibrary, FindsTheCanWithoutFalsePositives) {
     if (detection.model == "obj_000005") can_score = detection.score;
   }
   EXPECT_GT(can_score, 0.5) << run.output;
+
+  // With point pair hypotheses for the models the context did not find, the duck is found too, by its shape alone,
+  // within 2 cm and 5 degrees (its depth lies 5-7 mm off the ground truth's), and nothing is reported wrongly.
+  const std::string both = directory.File("both.json");
+  const test::CommandResult shaped = test::RunCli("recognize --db " + library + " " + scene + ":3 --depth " + depth +
+                                                  " --hypotheses both --threads 2 --out-json " + both);
+  ASSERT_EQ(shaped.exit_code, 0) << shaped.output;
+  const std::vector<Detection> shaped_detections = DetectionsFromJson(ReadJsonFile(both), both);
+  const FrameEvaluation shaped_evaluation =
+      EvaluateFrame("lmo", shaped_detections, frame.ground_truth, eval_models);
+  found.clear();
+  for (const ObjectEvaluation& object : shaped_evaluation.objects) {
+    if (!object.correct) continue;
+    found.push_back(object.model);
+    if (object.model == "obj_000009") {
+      EXPECT_LT(object.error.translation_mm, 20.0);
+      EXPECT_LT(object.error.rotation_deg, 5.0);
+    }
+  }
+  EXPECT_EQ(found, std::vector<std::string>({"obj_000005", "obj_000009"})) << shaped.output;
+  EXPECT_EQ(shaped_evaluation.false_positives, 0) << shaped.output;
+  for (const Detection& detection : shaped_detections) {
+    if (detection.model == "obj_000009") {
+      EXPECT_EQ(detection.hypothesis, HypothesisSource::kPpf);
+    }
+  }
 }
 
 }  // namespace
