@@ -139,8 +139,13 @@ void CheckMatFileStructure(const unsigned char* data, size_t size, const std::st
   }
   const bool swap = endian[0] == 'M';
   const unsigned version = swap ? (unsigned{data[124]} << 8 | data[125]) : (unsigned{data[125]} << 8 | data[124]);
-  if (version == 0x0200) return;  // 7.3: an HDF5 file
-  if (version != 0x0100) ThrowInputError(path, "header", "version 0x0100 (5) or 0x0200 (7.3)", std::to_string(version));
+  // 7.3 files are HDF5 files, which the HDF5 library reads by trusting them (it leaked on fuzzed ones); YCB-Video's are
+  // version 5, as scipy and MATLAB's -v7 write them.
+  if (version == 0x0200) {
+    ThrowInputError(path, "header", "a version 5 MAT-file (MATLAB: save -v7; scipy.io.savemat)",
+                    "version 7.3 (HDF5), which ecvpose does not read");
+  }
+  if (version != 0x0100) ThrowInputError(path, "header", "version 0x0100 (5)", std::to_string(version));
   const ElementReader reader(swap, path);
   size_t at = kHeaderBytes;
   while (at + 8 <= size) {
