@@ -449,6 +449,11 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
       RecognizerOptions sourced = options;
       sourced.point_pairs.source = ParseHypothesisSource(source, "--hypotheses");
       add_seeded(std::string(kOurs) + ", --hypotheses " + source, sourced, frames);
+      if (!methods.casts) continue;
+      for (const auto& [name, cast] : ColorCasts()) {
+        add_seeded(std::string(kOurs) + ", --hypotheses " + source + ", light " + name, sourced,
+                   CastFrames(frames, cast));
+      }
     }
     if (methods.track) {
       RecognizerOptions tracking = options;
@@ -663,7 +668,7 @@ int main(int argc, char** argv) {
   app.add_flag("--turned", methods.turned, "Also run ours on the frames turned 180 degrees (ground truth moved)");
   app.add_flag("--casts", methods.casts,
                "Also run ours on the frames under changed light: white balance 15 % warmer and cooler, gamma 0.8 and "
-               "1.25 (with each of --seeds)");
+               "1.25 (with each of --seeds and each --hypotheses source)");
   app.add_option("--python", methods.python, "Python interpreter with Open3D for the Open3D peer")
       ->capture_default_str();
   app.add_option("--figure", figure,
