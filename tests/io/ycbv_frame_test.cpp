@@ -106,18 +106,23 @@ TEST(YcbvFrame, AMetaFileWithMoreObjectsThanAFrameHoldsIsRefused) {
   EXPECT_NE(message.find("at most 1000 values"), std::string::npos) << message;
 }
 
-// Version 4 MAT-files (no text header), which matio reads by their own counts alone, are refused before it sees them.
-TEST(YcbvFrame, AVersion4MetaFileIsRefusedNamingTheVersion) {
-  test::TemporaryDirectory directory;
-  const std::string prefix = CopyOfFrameImages(directory);
-  mat_t* file = Mat_CreateVer((prefix + "-meta.mat").c_str(), nullptr, MAT_FT_MAT4);
+// A MAT-file at `path` of `version` holding only factor_depth.
+void WriteFactorDepth(const std::string& path, mat_ft version, matio_compression compression = MAT_COMPRESSION_NONE) {
+  mat_t* file = Mat_CreateVer(path.c_str(), nullptr, version);
   ASSERT_NE(file, nullptr);
   size_t dims[2] = {1, 1};
   double factor = 10000;
   matvar_t* variable = Mat_VarCreate("factor_depth", MAT_C_DOUBLE, MAT_T_DOUBLE, 2, dims, &factor, 0);
-  Mat_VarWrite(file, variable, MAT_COMPRESSION_NONE);
+  Mat_VarWrite(file, variable, compression);
   Mat_VarFree(variable);
   Mat_Close(file);
+}
+
+// Version 4 MAT-files (no text header), which matio reads by their own counts alone, are refused before it sees them.
+TEST(YcbvFrame, AVersion4MetaFileIsRefusedNamingTheVersion) {
+  test::TemporaryDirectory directory;
+  const std::string prefix = CopyOfFrameImages(directory);
+  WriteFactorDepth(prefix + "-meta.mat", MAT_FT_MAT4);
   const std::string message = Refusal(prefix);
   EXPECT_NE(message.find("version 5 or later"), std::string::npos) << message;
   EXPECT_NE(message.find("no such header"), std::string::npos) << message;
@@ -129,16 +134,7 @@ TEST(YcbvFrame, AMetaFileWhoseCountsExceedItIsRefusedBeforeMatioReadsIt) {
   test::TemporaryDirectory directory;
   const std::string prefix = CopyOfFrameImages(directory);
   const std::string meta = prefix + "-meta.mat";
-  auto write = [&](matio_compression compression) {
-    mat_t* file = Mat_CreateVer(meta.c_str(), nullptr, MAT_FT_MAT5);
-    ASSERT_NE(file, nullptr);
-    size_t dims[2] = {1, 1};
-    double factor = 10000;
-    matvar_t* variable = Mat_VarCreate("factor_depth", MAT_C_DOUBLE, MAT_T_DOUBLE, 2, dims, &factor, 0);
-    Mat_VarWrite(file, variable, compression);
-    Mat_VarFree(variable);
-    Mat_Close(file);
-  };
+  auto write = [&](matio_compression compression) { WriteFactorDepth(meta, MAT_FT_MAT5, compression); };
   auto patch = [&](size_t offset, std::vector<uint32_t> words) {
     std::fstream file(meta, std::ios::in | std::ios::out | std::ios::binary);
     file.seekp(static_cast<std::streamoff>(offset));
@@ -169,9 +165,7 @@ TEST(YcbvFrame, AMetaFileWhoseCountsExceedItIsRefusedBeforeMatioReadsIt) {
   patch(144, {0xffffffffU, 0xffffffffU});
   EXPECT_NE(Refusal(prefix).find("MAT-file element at byte 128"), std::string::npos);
   // Version 7.3 (HDF5) is refused by name: the HDF5 library trusts what it reads.
-  mat_t* file = Mat_CreateVer(meta.c_str(), nullptr, MAT_FT_MAT73);
-  ASSERT_NE(file, nullptr);
-  Mat_Close(file);
+  WriteFactorDepth(meta, MAT_FT_MAT73);
   message = Refusal(prefix);
   EXPECT_NE(message.find("version 7.3 (HDF5)"), std::string::npos) << message;
 }
