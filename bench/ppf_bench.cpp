@@ -34,6 +34,9 @@ int Run(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--coplanar", options.coplanar_deg, "Pairs of one plane within this angle are skipped (degrees)")
       ->capture_default_str();
+  app.add_option("--model-normals", options.keep_normal_deg,
+                 "A model voxel keeps a second point whose normal differs by more (180: one per voxel, as Drost)")
+      ->capture_default_str();
   app.add_option("--scene-normals", options.scene_keep_normal_deg,
                  "A scene voxel keeps a second point whose normal differs by more (180: one per voxel)")
       ->capture_default_str();

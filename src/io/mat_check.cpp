@@ -1,5 +1,6 @@
-// The element structure of MAT-files of version 5 ("MAT-File Format", MathWorks, 2021: a 128-byte header, then
-// tagged data elements of (type, byte count); a count's upper 16 bits set mark a small element packed in the tag).
+// The element structure of MAT-files of version 5 ("MAT-File Format", MathWorks: a 128-byte header, then tagged data
+// elements of (type, byte count); a type word with its upper 16 bits set is a small element, its byte count there and
+// its data in the tag's second word).
 
 #include "io/mat_check.h"
 
@@ -21,7 +22,7 @@ constexpr uint32_t kMiInt32 = 5, kMiUint32 = 6, kMiMatrix = 14, kMiCompressed = 
 constexpr uint32_t kSparseClass = 5;
 constexpr size_t kHeaderBytes = 128;
 constexpr size_t kMaxInflatedBytes = size_t{64} << 20;
-constexpr int kMaxDepth = 16;  // cells and structs of cells ...
+constexpr int kMaxDepth = 16;  // matrices within matrices (cells, structs)
 
 class ElementReader {
  public:
@@ -48,7 +49,10 @@ class ElementReader {
     while (at + 8 <= size) {
       uint32_t type = Word(body + at), bytes = Word(body + at + 4);
       const bool small = (type >> 16) != 0;
-      if (small) bytes = type >> 16, type &= 0xffffU;
+      if (small) {
+        bytes = type >> 16;
+        type &= 0xffffU;
+      }
       const size_t room = small ? 4 : size - at - 8;
       if (bytes > room) {
         Fail("an element of " + std::to_string(bytes) + " bytes where " + std::to_string(room) + " remain",
