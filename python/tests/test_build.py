@@ -58,3 +58,16 @@ def test_bad_build_arguments_are_named(tmp_path):
             ecvpose.build_models(db, DEMO_MESHES, **kwargs)
         assert name in str(error.value), (name, str(error.value))
     assert not os.path.exists(db)  # arguments are checked before the library is created
+
+
+def test_a_library_built_without_point_pairs_says_so_to_a_recognizer_that_wants_them(tmp_path):
+    db = str(tmp_path / "lib.sqlite")
+    sugar = os.path.join(DEMO_MESHES, "004_sugar_box")
+    ecvpose.build_models(db, [sugar], views=VIEWS, point_pairs=False)
+    library = ecvpose.ModelLibrary.open(db)
+    assert ecvpose.Recognizer(library).point_pair_warnings == []  # context hypotheses need none
+    [warning] = ecvpose.Recognizer(library, hypotheses="both").point_pair_warnings
+    assert "004_sugar_box" in warning and "--no-ppf" in warning, warning
+
+    ecvpose.build_models(db, [sugar], views=VIEWS)  # built again, with them
+    assert ecvpose.Recognizer(ecvpose.ModelLibrary.open(db), hypotheses="both").point_pair_warnings == []
