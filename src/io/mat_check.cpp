@@ -70,8 +70,7 @@ class ElementReader {
         const double limit = static_cast<double>(size);
         const double claimed = array_class == kSparseClass ? static_cast<double>(Word(data + 4)) : values;
         if (claimed > limit) {
-          Fail("a matrix of " + std::to_string(claimed) + " values in " + std::to_string(size) + " bytes",
-               offset + at);
+          Fail("a matrix of " + std::to_string(claimed) + " values in " + std::to_string(size) + " bytes", offset + at);
         }
       } else if (type == kMiMatrix && !small) {
         CheckMatrix(data, bytes, offset + at + 8, depth + 1);
@@ -87,7 +86,8 @@ class ElementReader {
     if (type == kMiMatrix) return CheckMatrix(data, bytes, offset + 8, 0);
     if (type != kMiCompressed) Fail("an element of type " + std::to_string(type) + " at the top level", offset);
     std::vector<unsigned char> inflated = Inflate(data, bytes, offset);
-    if (inflated.size() < 8 || Word(inflated.data()) != kMiMatrix) Fail("a compressed element without a matrix", offset);
+    if (inflated.size() < 8 || Word(inflated.data()) != kMiMatrix)
+      Fail("a compressed element without a matrix", offset);
     const uint32_t size = Word(inflated.data() + 4);
     if (size > inflated.size() - 8) {
       Fail("a compressed matrix of " + std::to_string(size) + " bytes that inflates to " +
@@ -133,9 +133,9 @@ class ElementReader {
 void CheckMatFileStructure(const unsigned char* data, size_t size, const std::string& path) {
   // Version 4 files have no text header, and matio trusts their counts alone (an 80-byte file took 2 GB).
   if (size < 6 || std::memcmp(data, "MATLAB", 6) != 0 || size < kHeaderBytes) {
-    ThrowInputError(path, "header", "a MATLAB MAT-file of version 5 or later (a 128-byte header \"MATLAB ...\")",
-                    size >= 6 && std::memcmp(data, "MATLAB", 6) == 0 ? std::to_string(size) + " bytes"
-                                                                      : "no such header");
+    ThrowInputError(
+        path, "header", "a MATLAB MAT-file of version 5 or later (a 128-byte header \"MATLAB ...\")",
+        size >= 6 && std::memcmp(data, "MATLAB", 6) == 0 ? std::to_string(size) + " bytes" : "no such header");
   }
   const unsigned char* endian = data + 126;
   if (!((endian[0] == 'I' && endian[1] == 'M') || (endian[0] == 'M' && endian[1] == 'I'))) {
@@ -155,9 +155,8 @@ void CheckMatFileStructure(const unsigned char* data, size_t size, const std::st
   while (at + 8 <= size) {
     const uint32_t type = reader.Word(data + at), bytes = reader.Word(data + at + 4);
     if (bytes > size - at - 8) {
-      reader.Fail("an element of " + std::to_string(bytes) + " bytes where " + std::to_string(size - at - 8) +
-                      " remain",
-                  at);
+      reader.Fail(
+          "an element of " + std::to_string(bytes) + " bytes where " + std::to_string(size - at - 8) + " remain", at);
     }
     reader.CheckTopLevel(type, data + at + 8, bytes, at);
     // Compressed elements follow one another unpadded; matrices are padded to 8 bytes.
@@ -171,7 +170,8 @@ void CheckMatFile(const std::string& path) {
   const std::streamoff size = file.tellg();
   constexpr std::streamoff kMaxBytes = std::streamoff{256} << 20;
   if (size < 0 || size > kMaxBytes) {
-    ThrowInputError(path, "size", "at most 256 MB (a YCB-Video meta file holds a few)", std::to_string(size) + " bytes");
+    ThrowInputError(path, "size", "at most 256 MB (a YCB-Video meta file holds a few)",
+                    std::to_string(size) + " bytes");
   }
   std::vector<unsigned char> bytes(static_cast<size_t>(size));
   file.seekg(0);

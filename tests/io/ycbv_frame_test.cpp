@@ -7,8 +7,8 @@
 
 #include <matio.h>
 
-#include <fstream>
 #include <gtest/gtest.h>
+#include <fstream>
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/error.h"

@@ -70,8 +70,7 @@ TEST(LmoLibrary, FindsTheCanAndWithPointPairsTheDuckWithoutFalsePositives) {
                                                   " --hypotheses both --threads 2 --out-json " + both);
   ASSERT_EQ(shaped.exit_code, 0) << shaped.output;
   const std::vector<Detection> shaped_detections = DetectionsFromJson(ReadJsonFile(both), both);
-  const FrameEvaluation shaped_evaluation =
-      EvaluateFrame("lmo", shaped_detections, frame.ground_truth, eval_models);
+  const FrameEvaluation shaped_evaluation = EvaluateFrame("lmo", shaped_detections, frame.ground_truth, eval_models);
   found.clear();
   for (const ObjectEvaluation& object : shaped_evaluation.objects) {
     if (!object.correct) continue;
