@@ -264,15 +264,15 @@ class Recognizer::Impl {
       return std::nullopt;
     }
     const PpfOptions& options = options_.point_pairs.ppf;
-    const bool stored =
-        record.point_pairs->sampling == PpfModelSampling::Of(options, options_.point_pairs.model_samples);
+    const PpfModelSampling sampling = PpfModelSampling::Of(options, options_.point_pairs.model_samples);
+    const bool stored = record.point_pairs->sampling == sampling;
     if (stored && !record.point_pairs->refusal.empty()) {
       *refusal = record.point_pairs->refusal;
       return std::nullopt;
     }
     try {
-      if (stored) return PpfModel::FromSampledPoints(record.point_pairs->points, mesh.Diameter(), options);
-      return PpfModel(SampleMeshSurface(mesh, options_.point_pairs.model_samples), mesh.Diameter(), options);
+      return PpfModel::FromSampledPoints(stored ? record.point_pairs->points : SampleModelPoints(mesh, sampling),
+                                         mesh.Diameter(), options);
     } catch (const InputError& error) {
       *refusal = error.what();
       return std::nullopt;

@@ -342,7 +342,11 @@ std::vector<OrientedPoint> WithoutDominantPlane(const std::vector<OrientedPoint>
     const float offset = -unit.dot(a);
     size_t count = 0;
     for (size_t k = 0; k < points.size(); k += step) count += on_plane(points[k], unit, offset) ? 1 : 0;
-    if (count > best_count) best_count = count, best_normal = unit, best_offset = offset;
+    if (count > best_count) {
+      best_count = count;
+      best_normal = unit;
+      best_offset = offset;
+    }
   }
   const size_t sampled = (points.size() + step - 1) / step;
   if (best_count == 0 || static_cast<double>(best_count) < options.min_share * static_cast<double>(sampled)) {

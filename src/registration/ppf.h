@@ -59,7 +59,7 @@ std::vector<OrientedPoint> OrientedScenePoints(const RgbdFrame& frame, int strid
 std::vector<OrientedPoint> OrientedScenePoints(const OrganizedScene& organized);
 
 /// How a model's point pair points are drawn from its mesh. A library stores them with these settings; the
-/// recognizer uses them when its PpfOptions sub-sample alike (FitsOptions).
+/// recognizer uses them when its PpfOptions sub-sample alike (PpfModelSampling::Of).
 struct PpfModelSampling {
   int samples = 20000;            ///< points spread over the mesh by area (SampleMeshSurface, seed 1) ...
   double sampling = 0.05;         ///< ... then sub-sampled so (PpfOptions::sampling, share of the diameter)
