@@ -390,7 +390,6 @@ struct Methods {
   std::vector<int> confirm_every;       ///< tracking also with each of these TrackingOptions::confirm_every
   double track_score = -1.0;            ///< >= 0: tracking's TrackingOptions::min_follow_score
   bool keep_plane = false;              ///< point pairs also vote with the scene's dominant plane
-  bool keep_found = false;              ///< point pairs also vote with the surfaces found already
 };
 
 // The `methods` on `frames` with the library at `db`.
@@ -408,7 +407,6 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
   Runs runs;
   RecognizerOptions options;
   options.point_pairs.remove_plane = !methods.keep_plane;
-  options.point_pairs.remove_found = !methods.keep_found;
   // A run of `settings` on `run_frames` labelled `label`, then one more per --seeds seed, labelled ", seed N".
   const auto add_seeded = [&](const std::string& label, RecognizerOptions settings,
                               const std::vector<NamedFrame>& run_frames) {
@@ -665,8 +663,6 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"context", "ppf", "both"}));
   app.add_flag("--ppf-keep-plane", methods.keep_plane,
                "Point pairs vote with the scene's dominant plane's points too (a table top; default: left out)");
-  app.add_flag("--ppf-keep-found", methods.keep_found,
-               "Point pairs vote with the surfaces of the objects found already too (default: left out)");
   app.add_option("--seeds", methods.seeds,
                  "Also run ours (and each --hypotheses run) with these RANSAC seeds (the default run has seed 1)");
   app.add_flag("--turned", methods.turned, "Also run ours on the frames turned 180 degrees (ground truth moved)");

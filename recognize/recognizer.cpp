@@ -279,29 +279,6 @@ class Recognizer::Impl {
     }
   }
 
-  // The scene's oriented depth samples that point pairs vote with: without the dominant plane (found among all
-  // samples) and the surfaces of the instances found already, as options_.point_pairs say.
-  std::vector<OrientedPoint> PointPairScene(const Scene& scene, const std::vector<ModelInFrame>& models) const {
-    const PointPairOptions& options = options_.point_pairs;
-    cv::Mat found;  // the depth samples on the surfaces found already
-    if (options.remove_found) {
-      found = cv::Mat::zeros(scene.organized.points.size(), CV_8UC1);
-      const int stride = options_.dense_stride_px;
-      for (const ModelInFrame& model : models) {
-        for (const Verified& instance : model.instances) {
-          for (const cv::Point& p : instance.surface) found.at<uchar>(p.y / stride, p.x / stride) = 1;
-        }
-      }
-    }
-    std::vector<OrientedPoint> points = OrientedScenePoints(scene.organized, found);
-    if (options.remove_plane) {
-      const std::optional<Eigen::Hyperplane<float, 3>> plane =
-          FindDominantPlane(found.empty() ? points : OrientedScenePoints(scene.organized), options.plane);
-      if (plane) points = OffPlane(points, *plane, options.plane);
-    }
-    return points;
-  }
-
   // Point pair hypotheses for every model still searched and not found (under kBoth: not found by the context), the
   // models on the workers. Adds the workers' times: voting (point_pairs), verification and ICP.
   void SearchByPointPairs(const Scene& scene, std::vector<ModelInFrame>* models, StageTimes* times) {
@@ -310,7 +287,10 @@ class Recognizer::Impl {
       if ((*models)[m].search && (*models)[m].instances.empty() && ppf_models_[m]) wanted.push_back(m);
     }
     if (wanted.empty()) return;
-    const std::vector<OrientedPoint> points = PointPairScene(scene, *models);
+    const std::vector<OrientedPoint> points =
+        options_.point_pairs.remove_plane
+            ? WithoutDominantPlane(OrientedScenePoints(scene.organized), options_.point_pairs.plane)
+            : OrientedScenePoints(scene.organized);
     std::vector<StageTimes> model_times(wanted.size());
     ParallelFor(wanted.size(), options_.ransac.threads, [&](size_t i) {
       std::optional<Verified> best = BestPointPairPose(wanted[i], scene, points, &model_times[i]);

@@ -59,9 +59,6 @@ struct PointPairOptions {
   /// scene's points (remove_plane false: never).
   bool remove_plane = true;
   ScenePlaneOptions plane;
-  /// The surfaces of the objects found already (by the context, or tracked) are left out of the voting: a found
-  /// object's points only vote for poses of other models where that object lies.
-  bool remove_found = true;
   int clusters = 5;  ///< the best pose clusters refined and verified per model
   /// Points spread over a model's mesh before sub-sampling. A library's stored points are used when they were drawn
   /// alike (PpfModelSampling); otherwise the model's points are drawn from its mesh when the recognizer loads.

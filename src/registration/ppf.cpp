@@ -186,17 +186,6 @@ std::vector<PpfPose> ClusterPoses(std::vector<Vote> votes, double diameter_m, co
   return clusters;
 }
 
-// Whether `point` lies on `plane` as `options` say; `min_cosine`: of options.normal_deg.
-bool OnPlane(const OrientedPoint& point, const Eigen::Hyperplane<float, 3>& plane, const ScenePlaneOptions& options,
-             float min_cosine) {
-  return plane.absDistance(point.position) <= static_cast<float>(options.distance_m) &&
-         std::abs(plane.normal().dot(point.normal)) >= min_cosine;
-}
-
-float MinCosine(const ScenePlaneOptions& options) {
-  return static_cast<float>(std::cos(options.normal_deg * kPi / 180.0));
-}
-
 }  // namespace
 
 void PpfOptions::Check() const {
@@ -302,14 +291,10 @@ std::vector<OrientedPoint> OrientedScenePoints(const RgbdFrame& frame, int strid
   return OrientedScenePoints(MakeOrganizedScene(frame.depth, frame.camera, stride));
 }
 
-std::vector<OrientedPoint> OrientedScenePoints(const OrganizedScene& organized, const cv::Mat& leave_out) {
-  if (!leave_out.empty() && (leave_out.size() != organized.points.size() || leave_out.type() != CV_8UC1)) {
-    ThrowInputError("oriented scene points", "leave_out", "a CV_8UC1 mask of the depth samples' size");
-  }
+std::vector<OrientedPoint> OrientedScenePoints(const OrganizedScene& organized) {
   std::vector<OrientedPoint> points;
   for (int v = 0; v < organized.points.rows; ++v) {
     for (int u = 0; u < organized.points.cols; ++u) {
-      if (!leave_out.empty() && leave_out.at<uchar>(v, u) != 0) continue;
       const cv::Vec3f p = organized.points.at<cv::Vec3f>(v, u), n = organized.normals.at<cv::Vec3f>(v, u);
       if (p[2] <= 0.0F || (n[0] == 0.0F && n[1] == 0.0F && n[2] == 0.0F)) continue;
       OrientedPoint point{{p[0], p[1], p[2]}, Eigen::Vector3f(n[0], n[1], n[2]).normalized()};
@@ -330,51 +315,49 @@ void ScenePlaneOptions::Check() const {
   require(iterations >= 1, "iterations", "at least 1");
 }
 
-std::optional<Eigen::Hyperplane<float, 3>> FindDominantPlane(const std::vector<OrientedPoint>& points,
-                                                             const ScenePlaneOptions& options) {
+std::vector<OrientedPoint> WithoutDominantPlane(const std::vector<OrientedPoint>& points,
+                                                const ScenePlaneOptions& options) {
   options.Check();
-  if (points.size() < 3) return std::nullopt;
-  const float min_cosine = MinCosine(options);
-  // Planes are scored on at most 4000 of the points, spread evenly.
+  if (points.size() < 3) return points;
+  const float distance = static_cast<float>(options.distance_m);
+  const float min_cosine = static_cast<float>(std::cos(options.normal_deg * kPi / 180.0));
+  auto on_plane = [&](const OrientedPoint& point, const Eigen::Vector3f& normal, float offset) {
+    return std::abs(normal.dot(point.position) + offset) <= distance &&
+           std::abs(normal.dot(point.normal)) >= min_cosine;
+  };
+  // Planes are scored on at most 4000 of the points, spread evenly; the best one then takes its points from all.
   const size_t step = std::max<size_t>(1, points.size() / 4000);
   std::mt19937 random(1);
   std::uniform_int_distribution<size_t> pick(0, points.size() - 1);
-  std::optional<Eigen::Hyperplane<float, 3>> best;
+  Eigen::Vector3f best_normal = Eigen::Vector3f::Zero();
+  float best_offset = 0.0F;
   size_t best_count = 0;
   for (int i = 0; i < options.iterations; ++i) {
     const Eigen::Vector3f& a = points[pick(random)].position;
     const Eigen::Vector3f& b = points[pick(random)].position;
     const Eigen::Vector3f& c = points[pick(random)].position;
-    if ((b - a).cross(c - a).norm() < 1e-9F) continue;
-    const Eigen::Hyperplane<float, 3> plane = Eigen::Hyperplane<float, 3>::Through(a, b, c);
+    const Eigen::Vector3f normal = (b - a).cross(c - a);
+    if (normal.norm() < 1e-9F) continue;
+    const Eigen::Vector3f unit = normal.normalized();
+    const float offset = -unit.dot(a);
     size_t count = 0;
-    for (size_t k = 0; k < points.size(); k += step) count += OnPlane(points[k], plane, options, min_cosine) ? 1 : 0;
+    for (size_t k = 0; k < points.size(); k += step) count += on_plane(points[k], unit, offset) ? 1 : 0;
     if (count > best_count) {
       best_count = count;
-      best = plane;
+      best_normal = unit;
+      best_offset = offset;
     }
   }
   const size_t sampled = (points.size() + step - 1) / step;
-  if (static_cast<double>(best_count) < options.min_share * static_cast<double>(sampled)) return std::nullopt;
-  return best;
-}
-
-std::vector<OrientedPoint> OffPlane(const std::vector<OrientedPoint>& points, const Eigen::Hyperplane<float, 3>& plane,
-                                    const ScenePlaneOptions& options) {
-  options.Check();
-  const float min_cosine = MinCosine(options);
+  if (best_count == 0 || static_cast<double>(best_count) < options.min_share * static_cast<double>(sampled)) {
+    return points;
+  }
   std::vector<OrientedPoint> kept;
   kept.reserve(points.size());
   for (const OrientedPoint& point : points) {
-    if (!OnPlane(point, plane, options, min_cosine)) kept.push_back(point);
+    if (!on_plane(point, best_normal, best_offset)) kept.push_back(point);
   }
   return kept;
-}
-
-std::vector<OrientedPoint> WithoutDominantPlane(const std::vector<OrientedPoint>& points,
-                                                const ScenePlaneOptions& options) {
-  const std::optional<Eigen::Hyperplane<float, 3>> plane = FindDominantPlane(points, options);
-  return plane ? OffPlane(points, *plane, options) : points;
 }
 
 PpfModelSampling PpfModelSampling::Of(const PpfOptions& options, int samples) {

@@ -1,7 +1,6 @@
 #pragma once
 
 #include <cstdint>
-#include <optional>
 #include <utility>
 #include <vector>
 
@@ -56,9 +55,8 @@ std::vector<OrientedPoint> SampleMeshSurface(const TriangleMesh& mesh, int count
 /// A frame's depth samples every `stride` pixels with their normals (MakeOrganizedScene), turned towards the camera;
 /// samples without a normal are left out.
 std::vector<OrientedPoint> OrientedScenePoints(const RgbdFrame& frame, int stride);
-/// The same of depth samples made already, without those where `leave_out` (CV_8UC1 of the samples' size, or empty)
-/// is non-zero.
-std::vector<OrientedPoint> OrientedScenePoints(const OrganizedScene& organized, const cv::Mat& leave_out = {});
+/// The same of depth samples made already.
+std::vector<OrientedPoint> OrientedScenePoints(const OrganizedScene& organized);
 
 /// How a model's point pair points are drawn from its mesh. A library stores them with these settings; the
 /// recognizer uses them when its PpfOptions sub-sample alike (PpfModelSampling::Of).
@@ -89,16 +87,8 @@ struct ScenePlaneOptions {
   void Check() const;
 };
 
-/// The plane of `points` that holds the most of them, if it holds at least options.min_share.
-std::optional<Eigen::Hyperplane<float, 3>> FindDominantPlane(const std::vector<OrientedPoint>& points,
-                                                             const ScenePlaneOptions& options = {});
-
-/// `points` without those on `plane` (within options.distance_m, normals within options.normal_deg).
-std::vector<OrientedPoint> OffPlane(const std::vector<OrientedPoint>& points, const Eigen::Hyperplane<float, 3>& plane,
-                                    const ScenePlaneOptions& options = {});
-
-/// `points` without those of their dominant plane, or all of them when no plane is. Pairs with a table top's points
-/// describe no object on it, and they are most of a frame's points.
+/// `points` without those of their dominant plane (ScenePlaneOptions), or all of them when no plane is. Pairs with a
+/// table top's points describe no object on it, and they are most of a frame's points.
 std::vector<OrientedPoint> WithoutDominantPlane(const std::vector<OrientedPoint>& points,
                                                 const ScenePlaneOptions& options = {});
 
