@@ -459,6 +459,12 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
       RecognizerOptions tracking = options;
       if (methods.track_score >= 0.0) tracking.tracking.min_follow_score = methods.track_score;
       runs.emplace_back(kTracking, RunRecognizer(library, tracking, frames, models, "track", true));
+      if (methods.casts) {
+        for (const auto& [name, cast] : ColorCasts()) {
+          const std::string label = std::string(kTracking) + ", light " + name;
+          runs.emplace_back(label, RunRecognizer(library, tracking, CastFrames(frames, cast), models, label, true));
+        }
+      }
       if (methods.search_every > 1) {
         runs.emplace_back(TrackingEvery(methods.search_every),
                           RunRecognizer(library, tracking, frames, models, "track every", true, methods.search_every));
@@ -668,7 +674,7 @@ int main(int argc, char** argv) {
   app.add_flag("--turned", methods.turned, "Also run ours on the frames turned 180 degrees (ground truth moved)");
   app.add_flag("--casts", methods.casts,
                "Also run ours on the frames under changed light: white balance 15 % warmer and cooler, gamma 0.8 and "
-               "1.25 (with each of --seeds and each --hypotheses source)");
+               "1.25 (with each of --seeds and each --hypotheses source; with --track, tracking too)");
   app.add_option("--python", methods.python, "Python interpreter with Open3D for the Open3D peer")
       ->capture_default_str();
   app.add_option("--figure", figure,
