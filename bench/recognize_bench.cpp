@@ -8,7 +8,7 @@
 //   scripts/build_ycbv_library /tmp/ycbv.sqlite --views 40 --distance 0.9
 //   scripts/build_lmo_library /tmp/lmo.sqlite --views 40 --distance 1.0
 //   recognize_bench --db /tmp/ycbv.sqlite [--lmo-db /tmp/lmo.sqlite] [--peers] [--track] [--search-every N]
-//                   [--confirm-every N...] [--track-score S] [--seeds S...]
+//                   [--confirm-every N...] [--confirm-first N...] [--track-score S] [--seeds S...]
 //                   [--threads N] [--bytes] [--preselect N] [--turned] [--casts] [--python EXE] [--figure F.jpg]
 //                   [--results bench/RESULTS.md] [--frames N]
 // --threads N (N > 1) adds a run of ours with N worker threads: the same detections (checked), its own times.
@@ -18,7 +18,8 @@
 // --casts adds runs of ours on the same frames under changed light (white balance, gamma; ColorCasts below).
 // --track adds a run with the previous frame's detections as priors; --search-every N (N > 1) one more where
 // only every N-th frame of a video searches the models that are not tracked (recognize --search-every);
-// --confirm-every N... adds tracking runs with each TrackingOptions::confirm_every for each of --seeds, and
+// --confirm-every N... adds tracking runs with each TrackingOptions::confirm_every for each of --seeds (and each
+// --confirm-first, and with --casts under each light), and
 // --track-score S sets the follow score of every tracking run (recognize --track-score).
 // --figure F.jpg draws the detections of ours and each peer in frame 0001/000001 (the demo frame) side by side.
 // --object-pixels also runs the peers on depth cut to the ground-truth objects' own pixels; --peers-only,
@@ -388,6 +389,7 @@ struct Methods {
   std::vector<std::string> hypotheses;  ///< ours also with these hypothesis sources (recognize --hypotheses)
   std::vector<uint64_t> seeds;          ///< ours, the hypothesis and the tracking runs repeated with these seeds
   std::vector<int> confirm_every;       ///< tracking also with each of these TrackingOptions::confirm_every
+  std::vector<int> confirm_first;       ///< ... and each of these TrackingOptions::confirm_first
   double track_score = -1.0;            ///< >= 0: tracking's TrackingOptions::min_follow_score
   bool keep_plane = false;              ///< point pairs also vote with the scene's dominant plane
 };
@@ -459,12 +461,6 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
       RecognizerOptions tracking = options;
       if (methods.track_score >= 0.0) tracking.tracking.min_follow_score = methods.track_score;
       runs.emplace_back(kTracking, RunRecognizer(library, tracking, frames, models, "track", true));
-      if (methods.casts) {
-        for (const auto& [name, cast] : ColorCasts()) {
-          const std::string label = std::string(kTracking) + ", light " + name;
-          runs.emplace_back(label, RunRecognizer(library, tracking, CastFrames(frames, cast), models, label, true));
-        }
-      }
       if (methods.search_every > 1) {
         runs.emplace_back(TrackingEvery(methods.search_every),
                           RunRecognizer(library, tracking, frames, models, "track every", true, methods.search_every));
@@ -473,14 +469,25 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
       if (confirm_every.empty()) confirm_every.push_back(tracking.tracking.confirm_every);
       std::vector<uint64_t> seeds = methods.seeds;
       if (seeds.empty()) seeds.push_back(tracking.ransac.seed);
+      std::vector<int> confirm_first = methods.confirm_first;
+      if (confirm_first.empty()) confirm_first.push_back(tracking.tracking.confirm_first);
       for (const int every : confirm_every) {
-        RecognizerOptions confirming = tracking;
-        confirming.tracking.confirm_every = every;
-        for (const uint64_t seed : seeds) {
-          confirming.ransac.seed = seed;
-          const std::string label =
-              std::string(kTracking) + ", confirm every " + std::to_string(every) + ", seed " + std::to_string(seed);
-          runs.emplace_back(label, RunRecognizer(library, confirming, frames, models, label, true));
+        for (const int first : confirm_first) {
+          RecognizerOptions confirming = tracking;
+          confirming.tracking.confirm_every = every;
+          confirming.tracking.confirm_first = first;
+          for (const uint64_t seed : seeds) {
+            confirming.ransac.seed = seed;
+            const std::string label = std::string(kTracking) + ", confirm every " + std::to_string(every) +
+                                      ", first " + std::to_string(first) + ", seed " + std::to_string(seed);
+            runs.emplace_back(label, RunRecognizer(library, confirming, frames, models, label, true));
+            if (!methods.casts) continue;
+            for (const auto& [name, cast] : ColorCasts()) {
+              const std::string cast_label = label + ", light " + name;
+              runs.emplace_back(cast_label,
+                                RunRecognizer(library, confirming, CastFrames(frames, cast), models, cast_label, true));
+            }
+          }
         }
       }
     }
@@ -650,6 +657,9 @@ int main(int argc, char** argv) {
                  "With --track: tracking also with each of these confirm_every values (recognize --confirm-every), "
                  "for each of --seeds");
   app.add_option("--track-score", methods.track_score, "With --track: the follow score (recognize --track-score)");
+  app.add_option("--confirm-first", methods.confirm_first,
+                 "With --track: tracking also with each of these confirm_first values (recognize --confirm-first), "
+                 "for each --confirm-every and seed");
   app.add_option("--threads", methods.threads, "N > 1 also runs ours with N worker threads (same detections checked)")
       ->check(AtLeastOne())
       ->capture_default_str();

@@ -109,6 +109,12 @@ void AddTrackingFlags(CLI::App& command, RecognizerArgs* args) {
                   "searched again; the better of the two poses is kept (0: never)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
+  command
+      .add_option("--confirm-first", args->options.tracking.confirm_first,
+                  "With --track: the same for an object no search has found again since the one that first found\n"
+                  "it (1: in the next frame; 0: as --confirm-every)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
 }
 
 // The flags of verification, RANSAC's inliers, matching and ICP.

@@ -248,6 +248,7 @@ class Recognizer::Impl {
     }
     best.detection.tracked = true;
     best.detection.frames_followed = prior.frames_followed + 1;
+    best.detection.confirmed = prior.confirmed;
     best.detection.hypothesis = prior.hypothesis;
     return best;
   }

@@ -40,6 +40,9 @@ struct Detection {
   /// Frames it has been followed since a search of its model last found it (0: a search found it in this frame);
   /// TrackingOptions::confirm_every.
   int frames_followed = 0;
+  /// A later search found it again on its surface (TrackingOptions::confirm_first); a tracked detection keeps its
+  /// prior's.
+  bool confirmed = false;
   /// Where its pose came from: kContext (view ranking and RANSAC) or kPpf (point pair features); a tracked
   /// detection keeps its first detection's.
   HypothesisSource hypothesis = HypothesisSource::kContext;

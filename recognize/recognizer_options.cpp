@@ -63,6 +63,7 @@ void RecognizerOptions::Check() const {
   require(tracking.min_follow_score >= 0.0 && tracking.min_follow_score <= 1.0, "tracking.min_follow_score",
           "in [0, 1]");
   require(tracking.confirm_every >= 0, "tracking.confirm_every", ">= 0 (0: never)");
+  require(tracking.confirm_first >= 0, "tracking.confirm_first", ">= 0 (0: at confirm_every)");
   require(views_per_model >= 1, "views_per_model", "at least 1");
   require(good_enough_score >= 0.0, "good_enough_score", ">= 0 (0: try every ranked view)");
   require(give_up_after_views >= 0, "give_up_after_views", ">= 0 (0: never give up)");

@@ -39,6 +39,10 @@ struct TrackingOptions {
   /// followed this many frames since a search last found it. The search's and the track's poses then compete on
   /// score: one on the same surface confirms the track, a better one elsewhere replaces it. 0: never.
   int confirm_every = 5;
+  /// A track no search has confirmed yet is due once followed this many frames instead (1: in the frame after the
+  /// search that found it): a wrong first detection would otherwise keep its model from being searched for
+  /// confirm_every frames. 0: at confirm_every as the others; unused when confirm_every is 0.
+  int confirm_first = 1;
 };
 
 /// Where pose hypotheses come from: the shape and appearance context descriptors (view ranking and RANSAC), point

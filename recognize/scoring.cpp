@@ -228,6 +228,7 @@ double Appearance(double color, const EdgeAgreement& edges, double weight, int m
 // one offset), it keeps the hue: per channel alone, a red label and a blue one with the same light-dark pattern
 // correlate perfectly (on YCB-Video the absent tomato soup can was reported on the blue master chef can).
 double ColorCorrelation(const std::vector<std::pair<Eigen::Vector3f, Eigen::Vector3f>>& colors) {
+  constexpr double kPlainSpread = 0.02;  // standard deviation of a plain channel's colours, 0..1 (5 of 255)
   constexpr size_t kMinPixels = 10;
   if (colors.size() < kMinPixels) return 0.0;
   Eigen::Vector3f model_mean = Eigen::Vector3f::Zero(), scene_mean = Eigen::Vector3f::Zero();
@@ -250,12 +251,19 @@ double ColorCorrelation(const std::vector<std::pair<Eigen::Vector3f, Eigen::Vect
     joint_model += joint_a.square().sum();
     joint_scene += joint_b.square().sum();
   }
-  double per_channel = 0.0;
+  // A channel in which the model is plain (its spread within the noise of a render) says nothing per channel: its
+  // correlation is weighed down, and where the model is plain in all three only the joint term (the hue) is left.
+  const double noise = kPlainSpread * kPlainSpread * static_cast<double>(colors.size());
+  double per_channel = 0.0, weights = 0.0;
   for (int k = 0; k < 3; ++k) {
-    per_channel += cross[k] / std::sqrt(std::max(1e-9F, model_variance[k] * scene_variance[k])) / 3.0;
+    const double weight = model_variance[k] / (model_variance[k] + noise);
+    per_channel += weight * cross[k] / std::sqrt(std::max(1e-9F, model_variance[k] * scene_variance[k]));
+    weights += weight;
   }
   const double joint = joint_cross / std::sqrt(std::max(1e-12, joint_model * joint_scene));
-  return std::max(0.0, std::min(per_channel, joint));
+  if (weights < 1e-9) return std::max(0.0, joint);
+  const double textured = weights / 3.0;
+  return std::max(0.0, textured * std::min(per_channel / weights, joint) + (1.0 - textured) * joint);
 }
 
 }  // namespace ecv

@@ -29,11 +29,12 @@ std::vector<ModelInFrame> AssignPriors(const std::vector<Detection>& priors,
 int ChooseModels(SearchScope scope, const TrackingOptions& tracking, int max_instances,
                  std::vector<ModelInFrame>* models) {
   const int confirm_every = tracking.confirm_every;
+  const int confirm_first = tracking.confirm_first > 0 ? tracking.confirm_first : confirm_every;
   int count = 0;
   for (ModelInFrame& model : *models) {
     const bool due =
         confirm_every > 0 && std::any_of(model.instances.begin(), model.instances.end(), [&](const Verified& instance) {
-          return instance.detection.frames_followed >= confirm_every;
+          return instance.detection.frames_followed >= (instance.detection.confirmed ? confirm_every : confirm_first);
         });
     if (due) {
       model.to_confirm = std::move(model.instances);
@@ -63,7 +64,10 @@ void MergeConfirmation(const cv::Size& image_size, double max_overlap, int max_i
       if (SharedFraction(candidate.surface, kept.surface, image_size) > max_overlap) same_surface = &kept;
     }
     if (same_surface != nullptr) {
-      if (same_surface->detection.tracked != candidate.detection.tracked) same_surface->detection.frames_followed = 0;
+      if (same_surface->detection.tracked != candidate.detection.tracked) {
+        same_surface->detection.frames_followed = 0;
+        same_surface->detection.confirmed = true;
+      }
       continue;
     }
     if (static_cast<int>(model->instances.size()) < max_instances) {

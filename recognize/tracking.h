@@ -36,15 +36,16 @@ std::vector<ModelInFrame> AssignPriors(const std::vector<Detection>& priors,
                                        const std::vector<std::string>& model_names, const TrackingOptions& tracking);
 
 /// Marks the models to search in this frame: those with fewer than `max_instances` instances (under kLostTracks only
-/// lost ones), and those with a track due for confirmation (followed tracking.confirm_every frames), whose tracked
-/// instances are set aside meanwhile. Returns their count.
+/// lost ones), and those with a track due for confirmation (followed tracking.confirm_every frames, or
+/// tracking.confirm_first while no search has confirmed it), whose tracked instances are set aside meanwhile. Returns
+/// their count.
 int ChooseModels(SearchScope scope, const TrackingOptions& tracking, int max_instances,
                  std::vector<ModelInFrame>* models);
 
 /// A confirming search's instances and the tracked ones it set aside compete on score: best first, each kept unless
 /// it lies mostly (`max_overlap`) on a kept one's surface, up to `max_instances`. A kept track that a searched
-/// instance lay on is confirmed (its count starts again); a track the search did not find keeps counting, so its
-/// model is searched again in the next frame. Nothing to do for a model without tracks set aside.
+/// instance lay on is confirmed (Detection::confirmed; its count starts again); a track the search did not find
+/// keeps counting, so its model is searched again in the next frame. Nothing to do for a model without tracks set aside.
 void MergeConfirmation(const cv::Size& image_size, double max_overlap, int max_instances, int stride,
                        ModelInFrame* model);
 

@@ -126,6 +126,8 @@ void SetKeyword(const std::string& key, const py::handle& value, RecognizeArgume
     o.tracking.min_follow_score = number(0, 1);
   } else if (key == "confirm_every") {
     o.tracking.confirm_every = count(0);
+  } else if (key == "confirm_first") {
+    o.tracking.confirm_first = count(0);
   } else if (key == "hypotheses") {
     o.point_pairs.source = ParseHypothesisSource(Cast<std::string>(key, value, "a string"), key);
   } else if (key == "views_per_model") {
@@ -239,6 +241,7 @@ void BindDetection(py::module_& m) {
       .def_readonly("edge_pixels", &Detection::edge_pixels)
       .def_readonly("tracked", &Detection::tracked)
       .def_readonly("frames_followed", &Detection::frames_followed)
+      .def_readonly("confirmed", &Detection::confirmed)
       .def_property_readonly("hypothesis", [](const Detection& d) { return HypothesisSourceName(d.hypothesis); })
       .def("__repr__", [](const Detection& d) {
         const Eigen::Vector3d t = d.camera_from_object.translation();

@@ -282,7 +282,9 @@ TEST_F(RecognizeEndToEnd, WhenEveryModelIsTrackedNoPrimitivesAreExtracted) {
   Recognizer recognizer(library);
   const RecognitionResult found = recognizer.Recognize(frame.rgbd);
   ASSERT_EQ(found.detections.size(), 2U);
-  const RecognitionResult tracked = recognizer.Recognize(frame.rgbd, found.detections);
+  std::vector<Detection> priors = found.detections;
+  for (Detection& prior : priors) prior.confirmed = true;  // tracks a later search has found again: none is due
+  const RecognitionResult tracked = recognizer.Recognize(frame.rgbd, priors);
   ASSERT_EQ(tracked.detections.size(), 2U);
   EXPECT_EQ(tracked.scene_primitives, 0);
   EXPECT_EQ(tracked.timings_ms.count("extract"), 0U);
@@ -318,6 +320,7 @@ TEST_F(RecognizeEndToEnd, APriorBelowTheFollowScoreIsNotFollowedFirstDetectionOr
     EXPECT_GT(result.scene_primitives, 0);
   }
   options.tracking.min_follow_score = priors[0].score;
+  priors[0].confirmed = true;  // not due for confirmation
   const RecognitionResult followed = Recognizer(library, options).Recognize(frame.rgbd, priors);
   ASSERT_EQ(followed.detections.size(), 1U);
   EXPECT_TRUE(followed.detections[0].tracked);
@@ -327,14 +330,23 @@ TEST_F(RecognizeEndToEnd, APriorBelowTheFollowScoreIsNotFollowedFirstDetectionOr
 
 // A track followed confirm_every frames since a search last found it has its model searched again: the search finds
 // the bottle on the track's surface, which confirms the track (its count starts again); a track not yet due is
-// followed without a search.
+// followed without a search. A track no search has confirmed yet is due in the frame after its first detection.
 TEST_F(RecognizeEndToEnd, ATrackDueForConfirmationIsSearchedAndConfirmedOnItsSurface) {
   const ModelLibrary library = Library({"006_mustard_bottle"});
   const LoadedFrame frame = LoadYcbvFrame(Frame());
   Recognizer recognizer(library);
   std::vector<Detection> priors = recognizer.Recognize(frame.rgbd).detections;
   ASSERT_EQ(priors.size(), 1U);
+  EXPECT_FALSE(priors[0].confirmed);
+  ASSERT_EQ(RecognizerOptions().tracking.confirm_first, 1);
+  const RecognitionResult young = recognizer.Recognize(frame.rgbd, priors, SearchScope::kLostTracks);
+  ASSERT_EQ(young.detections.size(), 1U);
+  EXPECT_EQ(young.views_tried.count("006_mustard_bottle"), 1U);
+  EXPECT_TRUE(young.detections[0].confirmed);
+  EXPECT_EQ(young.detections[0].frames_followed, 0);
+
   priors[0].tracked = true;
+  priors[0].confirmed = true;
   const int confirm_every = RecognizerOptions().tracking.confirm_every;
   ASSERT_GT(confirm_every, 1);
 
@@ -356,7 +368,8 @@ TEST_F(RecognizeEndToEnd, ATrackDueForConfirmationIsSearchedAndConfirmedOnItsSur
 }
 
 // A track that still verifies at a wrong place (here 20 cm beside the cracker box, with every pose reported) is
-// replaced when its confirming search finds the box where it is, with a higher score; until then it is followed.
+// replaced when its confirming search finds the box where it is, with a higher score; until then it is followed. A
+// wrong first detection is replaced in the next frame, when its track is first confirmed.
 TEST_F(RecognizeEndToEnd, ATrackTheConfirmingSearchDisagreesWithIsReplaced) {
   const ModelLibrary library = Library({"003_cracker_box"});
   const LoadedFrame frame = LoadYcbvFrame(Frame());
@@ -371,6 +384,7 @@ TEST_F(RecognizeEndToEnd, ATrackTheConfirmingSearchDisagreesWithIsReplaced) {
   priors[0].model = "003_cracker_box";
   priors[0].score = 1.0;
   priors[0].tracked = true;
+  priors[0].confirmed = true;
   priors[0].camera_from_object = truth->camera_from_object;
   priors[0].camera_from_object.translation().x() += 0.2;
 
@@ -386,6 +400,13 @@ TEST_F(RecognizeEndToEnd, ATrackTheConfirmingSearchDisagreesWithIsReplaced) {
   EXPECT_EQ(replaced.detections[0].frames_followed, 0);
   EXPECT_GT(replaced.detections[0].score, followed.detections[0].score);
   EXPECT_LT(TranslationDistance(replaced.detections[0].camera_from_object, truth->camera_from_object), 0.01);
+
+  priors[0].frames_followed = 0;
+  priors[0].confirmed = false;
+  const RecognitionResult first = recognizer.Recognize(frame.rgbd, priors);
+  ASSERT_EQ(first.detections.size(), 1U);
+  EXPECT_FALSE(first.detections[0].tracked);
+  EXPECT_LT(TranslationDistance(first.detections[0].camera_from_object, truth->camera_from_object), 0.01);
 }
 
 // A tracking frame that searches only for lost tracks (SearchScope::kLostTracks, `recognize --search-every`):
@@ -401,6 +422,7 @@ TEST_F(RecognizeEndToEnd, ALostTrackIsSearchedForAtOnceAndAModelWithoutAPriorOnl
   for (Detection prior : found.detections) {
     if (prior.model == "004_sugar_box") continue;
     prior.tracked = true;
+    prior.confirmed = true;
     if (prior.model == "006_mustard_bottle") prior.camera_from_object.translation().x() += 0.3;
     priors.push_back(prior);
   }

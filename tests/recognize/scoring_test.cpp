@@ -137,6 +137,28 @@ TEST(ColorCorrelation, IsLowForTheSamePatternInAnotherHue) {
   EXPECT_GT(ColorCorrelation(same_hue), 0.99);
 }
 
+// A plain yellow side (the model's colours within a render's noise): its hue decides. The scene's plain yellow under
+// a warmer light agrees; plain blue, grey and a printed pattern do not.
+TEST(ColorCorrelation, APlainModelIsJudgedByItsHue) {
+  std::mt19937 random(7);
+  std::normal_distribution<float> noise(0.0F, 0.005F);
+  std::uniform_real_distribution<float> value(0.0F, 1.0F);
+  const Eigen::Vector3f yellow(0.8F, 0.7F, 0.15F), warm(1.15F, 1.0F, 0.85F);
+  std::vector<std::pair<Eigen::Vector3f, Eigen::Vector3f>> same, blue, grey, printed;
+  for (int i = 0; i < 500; ++i) {
+    const Eigen::Vector3f model = yellow + Eigen::Vector3f(noise(random), noise(random), noise(random));
+    const Eigen::Vector3f jitter(noise(random), noise(random), noise(random));
+    same.emplace_back(model, 0.6F * warm.cwiseProduct(yellow) + 4.0F * jitter);
+    blue.emplace_back(model, Eigen::Vector3f(0.15F, 0.3F, 0.8F) + 4.0F * jitter);
+    grey.emplace_back(model, Eigen::Vector3f::Constant(0.6F) + 4.0F * jitter);
+    printed.emplace_back(model, Eigen::Vector3f(value(random), value(random), value(random)));
+  }
+  EXPECT_GT(ColorCorrelation(same), 0.9);
+  EXPECT_EQ(ColorCorrelation(blue), 0.0);
+  EXPECT_LT(ColorCorrelation(grey), 0.2);
+  EXPECT_LT(ColorCorrelation(printed), 0.2);
+}
+
 TEST(ColorCorrelation, IsNearZeroForUnrelatedColoursAndZeroWhenInverted) {
   auto unrelated = Colors(2000, 2);
   const auto others = Colors(2000, 3);

@@ -48,7 +48,8 @@ TEST(Tracking, ModelsSearchedAreThoseNotFoundUnderTheScopeAndThoseDueForConfirma
   TrackingOptions tracking;
   tracking.confirm_every = 5;
   std::vector<ModelInFrame> models(4);
-  AddInstance(Instance(0.6, {0, 0, 4, 4}, true, 2), 1, kImage, &models[0]);  // followed, not due
+  AddInstance(Instance(0.6, {0, 0, 4, 4}, true, 2), 1, kImage, &models[0]);  // followed, not due ...
+  models[0].instances[0].detection.confirmed = true;                         // ... once confirmed
   models[1].lost = true;                                                     // its prior failed
   AddInstance(Instance(0.6, {8, 8, 4, 4}, true, 5), 1, kImage, &models[3]);  // followed 5 frames: due
   EXPECT_EQ(ChooseModels(SearchScope::kLostTracks, tracking, 1, &models), 2);
@@ -63,7 +64,21 @@ TEST(Tracking, ModelsSearchedAreThoseNotFoundUnderTheScopeAndThoseDueForConfirma
   std::vector<ModelInFrame> full(2);
   AddInstance(Instance(0.6, {0, 0, 4, 4}, true, 1), 1, kImage, &full[0]);
   EXPECT_EQ(ChooseModels(SearchScope::kAllModels, tracking, 2, &full), 2);  // a second instance is looked for
-  tracking.confirm_every = 0;                                               // never confirmed
+  // A track no search has confirmed is due after tracking.confirm_first frames; a confirmed one after confirm_every.
+  tracking.confirm_first = 1;
+  std::vector<ModelInFrame> young(2);
+  AddInstance(Instance(0.6, {0, 0, 4, 4}, true, 1), 1, kImage, &young[0]);
+  AddInstance(Instance(0.6, {8, 8, 4, 4}, true, 1), 1, kImage, &young[1]);
+  young[1].instances[0].detection.confirmed = true;
+  EXPECT_EQ(ChooseModels(SearchScope::kLostTracks, tracking, 1, &young), 1);
+  EXPECT_TRUE(young[0].search);
+  EXPECT_FALSE(young[1].search);
+  tracking.confirm_first = 0;  // as the others
+  std::vector<ModelInFrame> as_others(1);
+  AddInstance(Instance(0.6, {0, 0, 4, 4}, true, 4), 1, kImage, &as_others[0]);
+  EXPECT_EQ(ChooseModels(SearchScope::kLostTracks, tracking, 1, &as_others), 0);
+  tracking.confirm_first = 1;
+  tracking.confirm_every = 0;  // never confirmed, young or not
   std::vector<ModelInFrame> never(1);
   AddInstance(Instance(0.6, {0, 0, 4, 4}, true, 50), 1, kImage, &never[0]);
   EXPECT_EQ(ChooseModels(SearchScope::kLostTracks, tracking, 1, &never), 0);
@@ -78,6 +93,7 @@ TEST(Tracking, AConfirmingSearchKeepsTheBetterPoseOfASurfaceAndConfirmsATrackItF
   ASSERT_EQ(confirmed.instances.size(), 1U);
   EXPECT_TRUE(confirmed.instances[0].detection.tracked);
   EXPECT_EQ(confirmed.instances[0].detection.frames_followed, 0);
+  EXPECT_TRUE(confirmed.instances[0].detection.confirmed);
   EXPECT_TRUE(confirmed.to_confirm.empty());
   EXPECT_EQ(cv::countNonZero(confirmed.covered), 11 * 11);  // its 10x10 surface and a pixel round it (at the corner)
 
@@ -96,6 +112,7 @@ TEST(Tracking, AConfirmingSearchKeepsTheBetterPoseOfASurfaceAndConfirmsATrackItF
   MergeConfirmation(kImage, 0.3, 1, 1, &unconfirmed);
   ASSERT_EQ(unconfirmed.instances.size(), 1U);
   EXPECT_EQ(unconfirmed.instances[0].detection.frames_followed, 5);
+  EXPECT_FALSE(unconfirmed.instances[0].detection.confirmed);
 
   // Two instances allowed: the track and a search elsewhere both stay.
   ModelInFrame both;
