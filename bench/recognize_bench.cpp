@@ -478,8 +478,8 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
           confirming.tracking.confirm_first = first;
           for (const uint64_t seed : seeds) {
             confirming.ransac.seed = seed;
-            const std::string label = std::string(kTracking) + ", confirm every " + std::to_string(every) +
-                                      ", first " + std::to_string(first) + ", seed " + std::to_string(seed);
+            const std::string label = std::string(kTracking) + ", confirm every " + std::to_string(every) + ", first " +
+                                      std::to_string(first) + ", seed " + std::to_string(seed);
             runs.emplace_back(label, RunRecognizer(library, confirming, frames, models, label, true));
             if (!methods.casts) continue;
             for (const auto& [name, cast] : ColorCasts()) {

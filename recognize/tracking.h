@@ -45,7 +45,8 @@ int ChooseModels(SearchScope scope, const TrackingOptions& tracking, int max_ins
 /// A confirming search's instances and the tracked ones it set aside compete on score: best first, each kept unless
 /// it lies mostly (`max_overlap`) on a kept one's surface, up to `max_instances`. A kept track that a searched
 /// instance lay on is confirmed (Detection::confirmed; its count starts again); a track the search did not find
-/// keeps counting, so its model is searched again in the next frame. Nothing to do for a model without tracks set aside.
+/// keeps counting, so its model is searched again in the next frame. Nothing to do for a model without tracks set
+/// aside.
 void MergeConfirmation(const cv::Size& image_size, double max_overlap, int max_instances, int stride,
                        ModelInFrame* model);
 
