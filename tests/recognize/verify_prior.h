@@ -18,7 +18,8 @@ inline Detection VerifyPrior(const ModelLibrary& library, const RecognizerOption
   prior.model = model;
   prior.camera_from_object = pose;
   prior.tracked = true;
-  prior.score = 1.0;  // followed whatever the bar
+  prior.score = 1.0;       // followed whatever the bar ...
+  prior.confirmed = true;  // ... and not searched for again
   const std::vector<Detection> found = Recognizer(library, options).Recognize(frame, {prior}).detections;
   EXPECT_EQ(found.size(), 1U) << model;
   return found.empty() ? Detection() : found[0];

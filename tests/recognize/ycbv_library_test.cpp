@@ -144,7 +144,8 @@ TEST_F(YcbvLibrary, TheGelatinBoxLyingOnThePuddingBoxScoresZeroThroughItsOutline
   ASSERT_EQ(priors.size(), 3U);
   for (Detection& prior : priors) {
     prior.tracked = true;
-    prior.score = 1.0;  // followed whatever the bar
+    prior.score = 1.0;       // followed whatever the bar ...
+    prior.confirmed = true;  // ... and not searched for again
   }
 
   RecognizerOptions options;
@@ -265,6 +266,7 @@ TEST_F(YcbvLibrary, UnderAnotherLightRightPosesKeepTheirScoresAndTheSoupCanIsNot
     prior.camera_from_object = TruthOf(frame, model).camera_from_object;
     prior.tracked = true;
     prior.score = 1.0;
+    prior.confirmed = true;
   }
   RecognizerOptions as_is;  // every prior reported with its score, at its pose
   as_is.verify.min_score = 0.0;
