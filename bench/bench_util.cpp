@@ -14,6 +14,7 @@
 #include <iostream>
 #include <limits>
 #include <numeric>
+#include <sstream>
 
 namespace ecv::bench {
 
@@ -88,13 +89,49 @@ std::vector<std::string> YcbvFramePrefixes(const std::string& data_dir) {
   return prefixes;
 }
 
-void Report(const std::string& results_path, const std::string& title, const std::string& command,
-            const std::string& markdown) {
+namespace {
+
+std::string Section(const std::string& title, const std::string& command, const std::string& markdown) {
   const std::time_t now = std::time(nullptr);
   char date[32];
   std::strftime(date, sizeof(date), "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
-  const std::string section =
-      "## " + title + "\n\n" + date + ", " + MachineDescription() + ", `" + command + "`\n\n" + markdown + "\n";
+  return "## " + title + "\n\n" + date + ", " + MachineDescription() + ", `" + command + "`\n\n" + markdown + "\n";
+}
+
+}  // namespace
+
+void ReportSection(const std::string& results_path, const std::string& title, const std::string& command,
+                   const std::string& markdown) {
+  const std::string section = Section(title, command, markdown);
+  std::cout << section;
+  std::string text;
+  {
+    std::ifstream in(results_path);
+    std::ostringstream whole;
+    whole << in.rdbuf();
+    text = whole.str();
+  }
+  const std::string heading = "## " + title + "\n";
+  size_t begin = text.rfind("\n" + heading);
+  begin = text.compare(0, heading.size(), heading) == 0 ? 0 : begin == std::string::npos ? begin : begin + 1;
+  if (begin == std::string::npos) {
+    text += (text.empty() || text.back() == '\n' ? "" : "\n") + section;
+  } else {
+    const size_t end = text.find("\n## ", begin + heading.size());
+    text.replace(begin, end == std::string::npos ? std::string::npos : end + 1 - begin, section);
+  }
+  const std::string temporary = results_path + ".tmp";
+  std::ofstream out(temporary);
+  out << text;
+  out.close();
+  if (!out || std::rename(temporary.c_str(), results_path.c_str()) != 0) {
+    std::cerr << "could not write " << results_path << '\n';
+  }
+}
+
+void Report(const std::string& results_path, const std::string& title, const std::string& command,
+            const std::string& markdown) {
+  const std::string section = Section(title, command, markdown);
   std::cout << section;
   std::ofstream results(results_path, std::ios::app);
   results << section;

@@ -54,4 +54,10 @@ int RunShellCommand(const std::string& command);
 void Report(const std::string& results_path, const std::string& title, const std::string& command,
             const std::string& markdown);
 
+/// Prints `markdown` under a heading with `title`, the date, the machine and the command, and puts it in
+/// `results_path` in place of the section with that heading (up to the next "## "), or at its end when it has none:
+/// the file keeps each bench's latest figures.
+void ReportSection(const std::string& results_path, const std::string& title, const std::string& command,
+                   const std::string& markdown);
+
 }  // namespace ecv::bench
