@@ -28,31 +28,17 @@ constexpr double kOverlapMm2 = 0.1;      // footprints overlapping by less count
 constexpr int kPlacementAttempts = 40;   // random places tried per object
 constexpr double kShadowBiasM = 0.005;   // a point is in shadow when the light sees this much nearer, metres
 constexpr double kLightDistanceM = 3.0;  // of the shadow map's camera from the scene centre, metres
-constexpr int kShadowMapSide = 1024;     // pixels
+constexpr int kShadowMapSide = 640;      // pixels a side, about 1 mm each over the objects
 
 // YCB-Video's cls_index by name (its dataset's 21 objects), 0 for other names.
 int YcbvClassIndex(const std::string& name) {
-  static const std::array<const char*, 21> kNames = {"002_master_chef_can",
-                                                     "003_cracker_box",
-                                                     "004_sugar_box",
-                                                     "005_tomato_soup_can",
-                                                     "006_mustard_bottle",
-                                                     "007_tuna_fish_can",
-                                                     "008_pudding_box",
-                                                     "009_gelatin_box",
-                                                     "010_potted_meat_can",
-                                                     "011_banana",
-                                                     "019_pitcher_base",
-                                                     "021_bleach_cleanser",
-                                                     "024_bowl",
-                                                     "025_mug",
-                                                     "035_power_drill",
-                                                     "036_wood_block",
-                                                     "037_scissors",
-                                                     "040_large_marker",
-                                                     "051_large_clamp",
-                                                     "052_extra_large_clamp",
-                                                     "061_foam_brick"};
+  // clang-format off
+  static const std::array<const char*, 21> kNames = {
+      "002_master_chef_can", "003_cracker_box", "004_sugar_box", "005_tomato_soup_can", "006_mustard_bottle",
+      "007_tuna_fish_can", "008_pudding_box", "009_gelatin_box", "010_potted_meat_can", "011_banana",
+      "019_pitcher_base", "021_bleach_cleanser", "024_bowl", "025_mug", "035_power_drill", "036_wood_block",
+      "037_scissors", "040_large_marker", "051_large_clamp", "052_extra_large_clamp", "061_foam_brick"};
+  // clang-format on
   for (size_t i = 0; i < kNames.size(); ++i) {
     if (name == kNames[i]) return static_cast<int>(i) + 1;
   }
@@ -408,7 +394,10 @@ class SceneMeshes {
  public:
   explicit SceneMeshes(Renderer& renderer) : renderer_(renderer) {}
   ~SceneMeshes() {
-    for (MeshId id : ids_) renderer_.RemoveMesh(id);
+    try {
+      for (MeshId id : ids_) renderer_.RemoveMesh(id);
+    } catch (const RenderError&) {  // a context that cannot be made current any more frees its meshes anyway
+    }
   }
   SceneMeshes(const SceneMeshes&) = delete;
   SceneMeshes& operator=(const SceneMeshes&) = delete;
@@ -485,7 +474,7 @@ Casters CastersOf(const std::vector<SceneAsset>& assets, const std::vector<MeshI
 // compared at the 3 x 3 map pixels around the point's projection (percentage-closer filtering, soft edges).
 cv::Mat Shadows(Renderer& renderer, const Casters& casters, const View& view, const cv::Mat& points,
                 const Eigen::Vector3d& to_light) {
-  const double range = std::max(casters.radius, 0.05);
+  const double range = std::clamp(casters.radius, 0.05, 0.5 * kLightDistanceM);
   PinholeCamera light_camera;
   light_camera.width = light_camera.height = kShadowMapSide;
   light_camera.fx = light_camera.fy = 0.5 * kShadowMapSide * (kLightDistanceM - range) / range;

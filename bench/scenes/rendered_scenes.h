@@ -19,13 +19,14 @@ struct SceneAsset {
   std::string name;      ///< model name as the library has it ("003_cracker_box"), or the clutter's ("obj_000005")
   TriangleMesh mesh;     ///< object frame, metres; textured, vertex-coloured or grey
   bool modelled = true;  ///< in the 16-model library: put in the ground truth; false: unmodelled clutter
-  bool repaint = false;  ///< no texture of its own: rendered in a random plain colour or a random texture
+  bool repaint = false;  ///< no texture of its own: rendered in a random plain colour per scene
   std::vector<RestingPose> resting_poses;  ///< RestingPoses(mesh), filled by LoadSceneAssets; computed when empty
 };
 
 /// The meshes of the generalisation scenes from `data_dir` (../shared/data): the 16 YCB-Video models (6 google16k
 /// textured meshes moved into the YCB-Video frame, the textured banana, 9 without texture, marked `repaint`) and
-/// the 8 LM-O meshes as clutter (`modelled` false). Throws InputError naming a missing file.
+/// the 8 LM-O meshes as clutter (`modelled` false), with their resting poses; textures capped at 2048 pixels a side.
+/// Throws InputError naming a missing file.
 std::vector<SceneAsset> LoadSceneAssets(const std::string& data_dir);
 
 /// Images the scenes' table tops and walls are cut from: real colour images with their objects filled in.
@@ -85,6 +86,8 @@ struct RenderedScene {
 /// resting poses with random yaw, placed on a table textured with a backdrop cut, touching and hiding each other,
 /// clutter among them, lit by a light of random colour, strength and direction, with the sensor's depth noise.
 /// Objects hidden to less than 10 % of their pixels are left out of the ground truth (not of the image).
+/// `mesh_ids[i]` is assets[i] uploaded to `renderer`; the table and wall are uploaded and removed per call. Throws
+/// InputError when mesh_ids do not match the assets, there are no backdrops or fewer modelled assets than min_objects.
 RenderedScene GenerateRenderedScene(Renderer& renderer, const std::vector<SceneAsset>& assets,
                                     const std::vector<MeshId>& mesh_ids, const Backdrops& backdrops, uint32_t seed,
                                     const RenderedSceneOptions& options = {});

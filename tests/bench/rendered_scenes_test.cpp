@@ -155,20 +155,48 @@ std::vector<Eigen::Vector3d> TableVertices(const TriangleMesh& mesh, const Eigen
   return vertices;
 }
 
-// Directions to test for a separating plane: every 0.25 degrees around the vertical, and spread over the sphere.
+constexpr int kAround = 3600;  // horizontal directions to test for a separating plane, every 0.1 degrees
+constexpr int kSphere = 100;   // pairs of opposite directions spread over the sphere, also tested
+
+// Directions to test for a separating plane: kAround around the vertical, then kSphere opposite pairs.
 std::vector<Eigen::Vector3d> SeparatingDirections() {
   std::vector<Eigen::Vector3d> directions;
-  for (int k = 0; k < 1440; ++k) {
-    const double angle = k * 2.0 * kPi / 1440;
+  for (int k = 0; k < kAround; ++k) {
+    const double angle = k * 2.0 * kPi / kAround;
     directions.emplace_back(std::cos(angle), std::sin(angle), 0.0);
   }
-  const int n = 400;  // Fibonacci sphere
-  for (int k = 0; k < n; ++k) {
-    const double z = 1.0 - (2.0 * k + 1.0) / n, r = std::sqrt(1.0 - z * z), phi = k * kPi * (3.0 - std::sqrt(5.0));
+  for (int k = 0; k < kSphere; ++k) {  // Fibonacci sphere
+    const double z = 1.0 - (2.0 * k + 1.0) / kSphere, r = std::sqrt(1.0 - z * z);
+    const double phi = k * kPi * (3.0 - std::sqrt(5.0));
     directions.emplace_back(r * std::cos(phi), r * std::sin(phi), z);
     directions.emplace_back(-r * std::cos(phi), -r * std::sin(phi), -z);
   }
   return directions;
+}
+
+size_t Opposite(size_t d) {
+  if (d < kAround) return (d + kAround / 2) % kAround;
+  return (d - kAround) % 2 == 0 ? d + 1 : d - 1;
+}
+
+// The support function of `vertices`: per direction, their largest coordinate along it. Along horizontal directions
+// only the outline seen from above (OpenCV's convex hull) can be extreme.
+std::vector<double> Support(const std::vector<Eigen::Vector3d>& vertices,
+                            const std::vector<Eigen::Vector3d>& directions) {
+  std::vector<cv::Point2f> seen_from_above, outline;
+  for (const Eigen::Vector3d& v : vertices)
+    seen_from_above.emplace_back(static_cast<float>(v.x()), static_cast<float>(v.y()));
+  cv::convexHull(seen_from_above, outline);
+  std::vector<double> support(directions.size(), -1e9);
+  for (size_t d = 0; d < directions.size(); ++d) {
+    if (d < kAround) {
+      for (const cv::Point2f& p : outline)
+        support[d] = std::max(support[d], p.x * directions[d].x() + p.y * directions[d].y());
+    } else {
+      for (const Eigen::Vector3d& v : vertices) support[d] = std::max(support[d], v.dot(directions[d]));
+    }
+  }
+  return support;
 }
 
 TEST(RenderedScenesTest, AssetsAreTheSixteenModelsAndEightClutterMeshes) {
@@ -191,6 +219,25 @@ TEST(RenderedScenesTest, AssetsAreTheSixteenModelsAndEightClutterMeshes) {
   EXPECT_FALSE(shared.assets[shared.AssetIndex("obj_000005")].modelled);
 }
 
+TEST(RenderedScenesTest, BrokenInputsAreInputErrors) {
+  const test::TemporaryDirectory empty;
+  EXPECT_THROW(LoadSceneAssets(empty.path().string()), InputError);
+  EXPECT_THROW(LoadBackdrops({empty.File("000001")}), InputError);
+  Renderer renderer;
+  std::vector<SceneAsset> boxes(3);
+  for (SceneAsset& asset : boxes) asset.mesh = Box({0.05F, 0.05F, 0.05F}, {0.0F, 0.0F, 0.0F});
+  std::vector<MeshId> mesh_ids;
+  for (const SceneAsset& asset : boxes) mesh_ids.push_back(renderer.AddMesh(asset.mesh));
+  EXPECT_THROW(GenerateRenderedScene(renderer, boxes, {mesh_ids[0]}, Backdrops{{cv::Mat(64, 64, CV_8UC3)}}, 1),
+               InputError);
+  EXPECT_THROW(GenerateRenderedScene(renderer, boxes, mesh_ids, Backdrops(), 1), InputError);
+  RenderedSceneOptions four;
+  four.min_objects = 4;
+  four.max_objects = 4;
+  EXPECT_THROW(GenerateRenderedScene(renderer, boxes, mesh_ids, Backdrops{{cv::Mat(64, 64, CV_8UC3)}}, 1, four),
+               InputError);
+}
+
 TEST(RenderedScenesTest, ObjectsRestOnTheTableWithoutInterpenetrating) {
   Shared& shared = GetShared();
   const std::vector<Eigen::Vector3d> directions = SeparatingDirections();
@@ -206,11 +253,7 @@ TEST(RenderedScenesTest, ObjectsRestOnTheTableWithoutInterpenetrating) {
       for (const Eigen::Vector3d& v : vertices) lowest = std::min(lowest, v.z());
       EXPECT_NEAR(lowest, 0.0, 0.001) << "seed " << seed << ", " << object.name << " does not rest on the table";
       EXPECT_TRUE(object.camera_from_object.isApprox(scene.camera_from_table * object.table_from_object, 1e-9));
-      std::vector<double> extent(directions.size(), -1e9);
-      for (size_t d = 0; d < directions.size(); ++d) {
-        for (const Eigen::Vector3d& v : vertices) extent[d] = std::max(extent[d], v.dot(directions[d]));
-      }
-      support.push_back(std::move(extent));
+      support.push_back(Support(vertices, directions));
     }
     EXPECT_GE(modelled, 3) << "seed " << seed;
     EXPECT_LE(modelled, 8) << "seed " << seed;
@@ -219,8 +262,7 @@ TEST(RenderedScenesTest, ObjectsRestOnTheTableWithoutInterpenetrating) {
       for (size_t b = a + 1; b < support.size(); ++b) {
         double smallest = 1e9;
         for (size_t d = 0; d < directions.size(); ++d) {
-          const size_t opposite = d < 1440 ? (d + 720) % 1440 : (d % 2 == 0 ? d + 1 : d - 1);
-          smallest = std::min(smallest, support[a][d] + support[b][opposite]);
+          smallest = std::min(smallest, support[a][d] + support[b][Opposite(d)]);
         }
         EXPECT_LE(smallest, 0.002) << "seed " << seed << ": " << scene.objects[a].name << " and "
                                    << scene.objects[b].name << " overlap by " << 1000 * smallest << " mm";
