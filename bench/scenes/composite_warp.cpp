@@ -14,6 +14,7 @@ namespace ecv::bench {
 namespace {
 
 constexpr int kFillPasses = 10;  // passes of 5x5 interpolation into the cut's depth holes
+constexpr int kHoleReachPx = 5;  // a hole in a target object's depth takes the nearest depth this far around it
 
 // `known` (CV_32F, 0 = unknown) with the unknown pixels of `mask` filled by the mean of known 5x5 neighbours,
 // growing inwards pass by pass.
@@ -168,12 +169,24 @@ Warp WarpCut(const Cut& cut, const Eigen::Isometry3d& target_from_source, const 
   return warp;
 }
 
-cv::Mat ShownMask(const Warp& warp, const cv::Mat& target_depth, double tolerance_m) {
+cv::Mat ShownMask(const Warp& warp, const cv::Mat& target_depth, const cv::Mat& target_labels, double tolerance_m) {
   cv::Mat shown = cv::Mat::zeros(warp.depth.size(), CV_8U);
+  if (warp.box.empty()) return shown;
+  // The holes of the target's labelled objects take the nearest depth around them (those along an outline belong to
+  // the object in front).
+  const cv::Rect around =
+      (warp.box + cv::Size(2 * kHoleReachPx, 2 * kHoleReachPx) - cv::Point(kHoleReachPx, kHoleReachPx)) &
+      cv::Rect(cv::Point(0, 0), target_depth.size());
+  cv::Mat measured = target_depth(around).clone(), nearest_around;
+  measured.setTo(std::numeric_limits<float>::infinity(), measured <= 0.0F);
+  const cv::Size window(2 * kHoleReachPx + 1, 2 * kHoleReachPx + 1);
+  cv::erode(measured, nearest_around, cv::getStructuringElement(cv::MORPH_RECT, window));
   for (int v = warp.box.y; v < warp.box.y + warp.box.height; ++v) {
     for (int u = warp.box.x; u < warp.box.x + warp.box.width; ++u) {
-      const float z = warp.depth.at<float>(v, u), behind = target_depth.at<float>(v, u);
-      if (z > 0.0F && (behind <= 0.0F || z < behind + tolerance_m)) shown.at<uint8_t>(v, u) = 255;
+      const float z = warp.depth.at<float>(v, u), behind = nearest_around.at<float>(v - around.y, u - around.x);
+      const float measured_z = target_depth.at<float>(v, u);
+      const float target = measured_z > 0.0F || target_labels.at<uint8_t>(v, u) == 0 ? measured_z : behind;
+      if (z > 0.0F && (target <= 0.0F || z < target + tolerance_m)) shown.at<uint8_t>(v, u) = 255;
     }
   }
   return shown;

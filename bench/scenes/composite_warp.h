@@ -48,7 +48,8 @@ Warp WarpCut(const Cut& cut, const Eigen::Isometry3d& target_from_source, const 
              double tolerance_m);
 
 /// CV_8U mask (255) of the pixels where `warp` shows in front of `target_depth`: nearer than it plus `tolerance_m`,
-/// or where it has no depth.
-cv::Mat ShownMask(const Warp& warp, const cv::Mat& target_depth, double tolerance_m);
+/// or where it has no depth. In the holes of the target's objects (`target_labels` > 0) the nearest depth within
+/// 5 px stands in for it.
+cv::Mat ShownMask(const Warp& warp, const cv::Mat& target_depth, const cv::Mat& target_labels, double tolerance_m);
 
 }  // namespace ecv::bench

@@ -91,6 +91,18 @@ struct Setting {
   Cut cut;
 };
 
+// The part of a composite that stays fixed over its placements.
+Setting Prepare(const SourceFrame& source, const GroundTruth& truth, const std::vector<Eigen::Vector3d>& points,
+                const SourceFrame& target, const CompositeOptions& options) {
+  Setting setting{source, target, truth, points, options, {}, {}, CutObject(source, truth, points, options)};
+  setting.pasted = FootingOf(points, truth.camera_from_object, source.table);
+  for (const GroundTruth& other : target.frame.ground_truth) {
+    setting.neighbours.push_back(
+        FootingOf(PointsOf(target, other.object_name), other.camera_from_object, target.table));
+  }
+  return setting;
+}
+
 // The move that turns the object by `turn_rad` about the target table's normal after the least rotation taking the
 // source table's normal to it, with its lowest point on the target table and its centre above `place`.
 Eigen::Isometry3d MoveOnto(const Setting& setting, const Eigen::Vector3d& place, double turn_rad) {
@@ -163,7 +175,7 @@ Rejection Judge(const Setting& setting, const Eigen::Isometry3d& move, const Eig
   const RgbdFrame& rgbd = setting.target.frame.rgbd;
   *warp = WarpCut(setting.cut, move, rgbd.camera, options.occlusion_tolerance_m);
   if (warp->inside < options.min_inside_share * warp->points) return Rejection::kLeftImage;
-  *shown = ShownMask(*warp, rgbd.depth, options.occlusion_tolerance_m);
+  *shown = ShownMask(*warp, rgbd.depth, setting.target.labels, options.occlusion_tolerance_m);
   if (HiddenShare(setting.target, *shown) > options.max_hidden_share) return Rejection::kHidTarget;
   return Rejection::kNone;
 }
@@ -254,6 +266,32 @@ bool SamplePlace(const Setting& setting, int next_to, std::mt19937* rng, Eigen::
   return true;
 }
 
+// The least-squares plane of the points within kPlaneInlierM of `plane` (the normal is their direction of least
+// spread), its normal towards the camera; inliers 0 when fewer than 3 points are near `plane`, 1 otherwise.
+TablePlane RefinedPlane(const std::vector<Eigen::Vector3d>& points, const TablePlane& plane) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  int count = 0;
+  for (const Eigen::Vector3d& point : points) {
+    if (std::abs(plane.Height(point)) >= kPlaneInlierM) continue;
+    mean += point;
+    scatter += point * point.transpose();
+    ++count;
+  }
+  TablePlane refined;
+  if (count < 3) return refined;
+  mean /= count;
+  scatter = scatter / count - mean * mean.transpose();
+  refined.normal = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors().col(0).normalized();
+  refined.offset = -refined.normal.dot(mean);
+  if (refined.offset < 0.0) {  // the camera (the origin) lies on the side the normal points to
+    refined.normal = -refined.normal;
+    refined.offset = -refined.offset;
+  }
+  refined.inliers = 1;
+  return refined;
+}
+
 }  // namespace
 
 TablePlane FitTablePlane(const RgbdFrame& frame, const cv::Mat& labels, uint32_t seed) {
@@ -288,27 +326,8 @@ TablePlane FitTablePlane(const RgbdFrame& frame, const cv::Mat& labels, uint32_t
     plane.inliers = count_inliers(plane);
     if (plane.inliers > best.inliers) best = plane;
   }
-  // Least squares on the inliers: the normal is the direction of least spread.
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-  int count = 0;
-  for (const Eigen::Vector3d& point : points) {
-    if (std::abs(best.Height(point)) >= kPlaneInlierM) continue;
-    mean += point;
-    scatter += point * point.transpose();
-    ++count;
-  }
-  if (count < 3) return TablePlane();
-  mean /= count;
-  scatter = scatter / count - mean * mean.transpose();
-  TablePlane refined;
-  refined.normal = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors().col(0).normalized();
-  refined.offset = -refined.normal.dot(mean);
-  if (refined.offset < 0.0) {  // the camera (the origin) lies on the side the normal points to
-    refined.normal = -refined.normal;
-    refined.offset = -refined.offset;
-  }
-  refined.inliers = count_inliers(refined);
+  TablePlane refined = RefinedPlane(points, best);
+  refined.inliers = refined.inliers > 0 ? count_inliers(refined) : 0;
   return refined;
 }
 
@@ -361,7 +380,9 @@ bool MakeComposite(const SourceFrame& source, const std::string& object_name, co
                    CompositeAttempts* attempts) {
   options.Check();
   if (out == nullptr) ThrowInputError("MakeComposite", "out", "a composite to fill", "null");
-  CompositeAttempts log;
+  CompositeAttempts unused;
+  CompositeAttempts& log = attempts != nullptr ? *attempts : unused;
+  log = CompositeAttempts();
   const GroundTruth& truth = TruthOf(source, object_name, "object_name");
   const std::vector<Eigen::Vector3d>& points = PointsOf(source, object_name);
   const int next_to =
@@ -370,21 +391,14 @@ bool MakeComposite(const SourceFrame& source, const std::string& object_name, co
     ThrowInputError(source.prefix + "-label.png", "label", "pixels of class " + std::to_string(truth.object_id));
   }
   log.refused = Refusal(source, truth, target, options);
-  if (attempts != nullptr) *attempts = log;
   if (!log.refused.empty()) return false;
-  Setting setting{source,  target,
-                  truth,   points,
-                  options, FootingOf(points, truth.camera_from_object, source.table),
-                  {},      CutObject(source, truth, points, options)};
-  for (const GroundTruth& other : target.frame.ground_truth) {
-    setting.neighbours.push_back(
-        FootingOf(PointsOf(target, other.object_name), other.camera_from_object, target.table));
-  }
+  const Setting setting = Prepare(source, truth, points, target, options);
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   Warp warp;
   cv::Mat shown;
-  for (log.tried = 1; log.tried <= options.attempts; ++log.tried) {
+  for (int attempt = 0; attempt < options.attempts; ++attempt) {
+    ++log.tried;
     const double turn_rad = Radians(options.max_turn_deg) * (2.0 * unit(rng) - 1.0);
     Eigen::Vector3d place;
     const Rejection rejection = SamplePlace(setting, next_to, &rng, &place)
@@ -395,11 +409,8 @@ bool MakeComposite(const SourceFrame& source, const std::string& object_name, co
     *out = Assemble(setting, MoveOnto(setting, place, turn_rad), warp, shown);
     out->beside = beside;
     out->attempts = log;
-    if (attempts != nullptr) *attempts = log;
     return true;
   }
-  log.tried = options.attempts;
-  if (attempts != nullptr) *attempts = log;
   return false;
 }
 
