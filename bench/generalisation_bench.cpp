@@ -241,7 +241,7 @@ std::string Digest(const Run& run) {
 
 // One picture per set: the first frame of each condition with the run's detections drawn, captioned.
 void WriteFigures(const ModelLibrary& library, const Run& run, const std::vector<BenchFrame>& frames,
-                  const std::string& folder, const std::string& tag) {
+                  const std::string& folder, const std::string& tag, const std::string& format) {
   Recognizer recognizer(library);
   std::map<std::string, std::vector<cv::Mat>> panels;  // set -> panels
   std::set<std::string> drawn;
@@ -272,7 +272,7 @@ void WriteFigures(const ModelLibrary& library, const Run& run, const std::vector
     cv::vconcat(rows, figure);
     cv::resize(figure, figure, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
     cv::cvtColor(figure, bgr, cv::COLOR_RGB2BGR);
-    const std::string path = folder + "/generalisation_" + set + "_" + tag + ".jpg";
+    const std::string path = folder + "/generalisation_" + set + "_" + tag + "." + format;
     cv::imwrite(path, bgr, {cv::IMWRITE_JPEG_QUALITY, 80});
     std::cerr << "wrote " << path << '\n';
   }
@@ -280,7 +280,7 @@ void WriteFigures(const ModelLibrary& library, const Run& run, const std::vector
 
 struct Settings {
   std::string db, data = ECV_DATA_DIR, results = std::string(ECV_SOURCE_DIR) + "/bench/RESULTS.md",
-                  figures = std::string(ECV_SOURCE_DIR) + "/bench/figures", split = "reporting";
+                  figures = std::string(ECV_SOURCE_DIR) + "/bench/figures", split = "reporting", figure_format = "jpg";
   std::vector<std::string> hypotheses = {"context"};
   std::vector<uint64_t> seeds = {1};
   int rendered = 200, composites = 100, threads = 2;
@@ -301,6 +301,7 @@ int Main(int argc, char** argv) {
   app.add_option("--threads", s.threads, "Recognizer worker threads")->check(AtLeastOne());
   app.add_flag("--track", s.track, "Also track along the cast videos (recognize --track)");
   app.add_option("--figures", s.figures, "Folder of the pictures (one per set)");
+  app.add_option("--figure-format", s.figure_format, "Picture format")->check(CLI::IsMember({"jpg", "png"}));
   app.add_option("--results", s.results, "Markdown file the report goes to");
   if (const auto exit_code = ParseCommandLine(app, argc, argv)) return *exit_code;
   const SplitHalf half = s.split == "choosing" ? SplitHalf::kChoosing : SplitHalf::kReporting;
@@ -352,7 +353,7 @@ int Main(int argc, char** argv) {
   const double total_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   const std::string tag = std::to_string(library.models().size()) + "models";
-  if (!s.figures.empty() && !runs.empty()) WriteFigures(library, runs.front(), frames, s.figures, tag);
+  if (!s.figures.empty() && !runs.empty()) WriteFigures(library, runs.front(), frames, s.figures, tag, s.figure_format);
 
   std::ostringstream report;
   std::map<std::string, int> per_set;
