@@ -114,8 +114,9 @@ void ReportSection(const std::string& results_path, const std::string& title, co
   const std::string heading = "## " + title + "\n";
   size_t begin = text.rfind("\n" + heading);
   begin = text.compare(0, heading.size(), heading) == 0 ? 0 : begin == std::string::npos ? begin : begin + 1;
-  if (begin == std::string::npos) {
-    text += (text.empty() || text.back() == '\n' ? "" : "\n") + section;
+  if (begin == std::string::npos) {  // a new section, after a blank line
+    while (!text.empty() && text.back() == '\n') text.pop_back();
+    text += (text.empty() ? "" : "\n\n") + section;
   } else {
     const size_t end = text.find("\n## ", begin + heading.size());
     text.replace(begin, end == std::string::npos ? std::string::npos : end + 1 - begin, section);
@@ -127,15 +128,6 @@ void ReportSection(const std::string& results_path, const std::string& title, co
   if (!out || std::rename(temporary.c_str(), results_path.c_str()) != 0) {
     std::cerr << "could not write " << results_path << '\n';
   }
-}
-
-void Report(const std::string& results_path, const std::string& title, const std::string& command,
-            const std::string& markdown) {
-  const std::string section = Section(title, command, markdown);
-  std::cout << section;
-  std::ofstream results(results_path, std::ios::app);
-  results << section;
-  if (!results) std::cerr << "could not append to " << results_path << '\n';
 }
 
 std::string ShellQuoted(const std::string& text) {

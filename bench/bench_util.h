@@ -49,14 +49,10 @@ std::string ShellQuoted(const std::string& text);
 /// Runs `command` with the shell; its exit code, or -1 when it did not exit normally.
 int RunShellCommand(const std::string& command);
 
-/// Prints `markdown` and appends it to `results_path` under a heading with `title`, the date, the machine
-/// and the command.
-void Report(const std::string& results_path, const std::string& title, const std::string& command,
-            const std::string& markdown);
-
 /// Prints `markdown` under a heading with `title`, the date, the machine and the command, and puts it in
 /// `results_path` in place of the section with that heading (up to the next "## "), or at its end when it has none:
-/// the file keeps each bench's latest figures.
+/// the file keeps each bench's latest figures (git keeps the older ones). `title` must not change from run to run
+/// (no date, no flags), and `markdown` must not hold a line starting with "## " (use "### " within a section).
 void ReportSection(const std::string& results_path, const std::string& title, const std::string& command,
                    const std::string& markdown);
 

@@ -673,9 +673,10 @@ int main(int argc, char** argv) {
   app.add_option("--trials", settings.trials, "Seeded synthetic fits per cell (pair count, mislabelled share, method)")
       ->capture_default_str();
   app.add_option("--data", settings.data, "Data directory (with ycbv_subset)")->capture_default_str();
-  app.add_option("--results", settings.results, "Markdown file the report is appended to")->capture_default_str();
+  app.add_option("--results", settings.results, "Markdown file whose section of this bench the report replaces")
+      ->capture_default_str();
   app.add_flag_callback(
-      "--no-report", [&settings] { settings.report = false; }, "Print the tables only: append nothing to --results");
+      "--no-report", [&settings] { settings.report = false; }, "Print the tables only: write nothing to --results");
   app.add_flag("--effect", settings.effect,
                "Instead of the synthetic and real fits: the hand-labelled pairs and the fitted matrices' effect on "
                "held-out frames");
@@ -688,9 +689,9 @@ int main(int argc, char** argv) {
       const std::string markdown = EffectReport(settings);
       std::cout << markdown;
       if (settings.report) {
-        ecv::bench::Report(settings.results,
-                           "Colour calibration: hand pairs and the effect on matching (colorcal_bench)",
-                           ecv::bench::CommandLine(argc, argv), markdown);
+        ecv::bench::ReportSection(settings.results,
+                                  "Colour calibration: hand pairs and the effect on matching (colorcal_bench)",
+                                  ecv::bench::CommandLine(argc, argv), markdown);
       }
       return 0;
     }
@@ -704,8 +705,8 @@ int main(int argc, char** argv) {
     std::cout << real;
     markdown += real;
     if (settings.report) {
-      ecv::bench::Report(settings.results, "Colour calibration (colorcal_bench)", ecv::bench::CommandLine(argc, argv),
-                         markdown);
+      ecv::bench::ReportSection(settings.results, "Colour calibration (colorcal_bench)",
+                                ecv::bench::CommandLine(argc, argv), markdown);
     }
   } catch (const ecv::InputError& error) {
     std::cerr << "colorcal_bench: " << error.what() << '\n';

@@ -544,7 +544,8 @@ int main(int argc, char** argv) {
       "discriminative_bench: correspondence score of the ECV context descriptor and its peers on real view "
       "pairs with known relative pose (paper Fig. 7), and the descriptor's ablations.",
       "discriminative_bench"};
-  app.add_option("--results", results, "Markdown file the report is appended to")->capture_default_str();
+  app.add_option("--results", results, "Markdown file whose section of this bench the report replaces")
+      ->capture_default_str();
   app.add_option("--figures", figures, "Directory the bar chart and the picture of matches are written to")
       ->capture_default_str();
   app.add_flag("--ablations-only", ablations_only, "Only the ablation table: no peers, no figures");
@@ -577,8 +578,8 @@ int main(int argc, char** argv) {
   std::cerr << '\n';
   if (ablations_only) {
     std::cout << ablations;
-    Report(results, "Ablations of the ECV context descriptor (discriminative_bench)", CommandLine(argc, argv),
-           ablations);
+    ReportSection(results, "Ablations of the ECV context descriptor (discriminative_bench)", CommandLine(argc, argv),
+                  ablations);
     return 0;
   }
   std::string report =
@@ -607,6 +608,6 @@ int main(int argc, char** argv) {
       break;
     }
   }
-  Report(results, "Discriminative power of descriptors (paper Fig. 7)", CommandLine(argc, argv), report);
+  ReportSection(results, "Discriminative power of descriptors (paper Fig. 7)", CommandLine(argc, argv), report);
   return 0;
 }

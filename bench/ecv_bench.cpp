@@ -147,11 +147,12 @@ int main(int argc, char** argv) {
   app.add_option("--runs", settings.runs, "Runs per frame; the fastest counts")
       ->check(ecv::bench::AtLeastOne())
       ->capture_default_str();
-  app.add_option("--results", settings.results, "Markdown file the report is appended to")->capture_default_str();
+  app.add_option("--results", settings.results, "Markdown file whose section of this bench the report replaces")
+      ->capture_default_str();
   if (const auto exit_code = ecv::bench::ParseCommandLine(app, argc, argv)) return *exit_code;
   try {
     const std::string table = Measure(settings);
-    ecv::bench::Report(settings.results, "ECV primitive extraction", ecv::bench::CommandLine(argc, argv), table);
+    ecv::bench::ReportSection(settings.results, "ECV primitive extraction", ecv::bench::CommandLine(argc, argv), table);
   } catch (const std::exception& error) {
     std::cerr << "ecv_bench: " << error.what() << '\n';
     return 1;

@@ -146,7 +146,8 @@ int main(int argc, char** argv) {
       ->check(AtLeastOne())
       ->capture_default_str();
   app.add_option("--overlay", overlay, "Picture of the two-instance detections, seed 1 (default: none)");
-  app.add_option("--results", results, "Markdown file the report is appended to")->capture_default_str();
+  app.add_option("--results", results, "Markdown file whose section of this bench the report replaces")
+      ->capture_default_str();
   app.footer(
       "Libraries:\n  ecvpose modeldb build models/meshes --views 40 --distance 0.9 --db DEMO_LIB.sqlite\n"
       "  scripts/build_ycbv_library YCBV_LIB.sqlite --views 40 --distance 0.9");
@@ -156,7 +157,7 @@ int main(int argc, char** argv) {
     load.build_matchers = false;
     std::string markdown = TwoBottlesTable(ModelLibrary::Load(db, load), seeds, overlay);
     if (!ycbv_db.empty()) markdown += SingleInstanceTable(ModelLibrary::Load(ycbv_db, load));
-    Report(results, "Several instances of one model (instances_bench)", CommandLine(argc, argv), markdown);
+    ReportSection(results, "Several instances of one model (instances_bench)", CommandLine(argc, argv), markdown);
   } catch (const std::exception& error) {
     std::cerr << "instances_bench: " << error.what() << '\n';
     return 1;

@@ -235,13 +235,14 @@ int main(int argc, char** argv) {
   app.add_option("--frames", settings.frames, "YCB-Video frames, spread over the three videos")
       ->check(ecv::bench::AtLeastOne())
       ->capture_default_str();
-  app.add_option("--results", settings.results, "Markdown file the report is appended to")->capture_default_str();
+  app.add_option("--results", settings.results, "Markdown file whose section of this bench the report replaces")
+      ->capture_default_str();
   app.footer("Library:\n  scripts/build_ycbv_library /tmp/ycbv.sqlite --views 40 --distance 0.9");
   if (const auto exit_code = ecv::bench::ParseCommandLine(app, argc, argv)) return *exit_code;
   try {
     const std::string table = ecv::bench::Run(settings);
-    ecv::bench::Report(settings.results, "Descriptor matching: KdForest and FLANN (matching_bench)",
-                       ecv::bench::CommandLine(argc, argv), table);
+    ecv::bench::ReportSection(settings.results, "Descriptor matching: KdForest and FLANN (matching_bench)",
+                              ecv::bench::CommandLine(argc, argv), table);
   } catch (const std::exception& error) {
     std::cerr << "matching_bench: " << error.what() << '\n';
     return 1;

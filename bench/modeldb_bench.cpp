@@ -6,7 +6,7 @@
 //  3. Scaling: load and query time for libraries of 10, 100 and 1000 models, synthesised by re-adding the
 //     built models' views under new names (fewer views per model there; said in the table).
 //  Peer: the same records read from a flat binary file (no SQL, no index) in the same run.
-// Appends a section to bench/RESULTS.md (bench_util Report).
+// Replaces its section of bench/RESULTS.md (bench_util ReportSection).
 //
 //   modeldb_bench [--views N] [--fit-views N] [--scale-views N] [--study-views N] [--scales N,N,...] [--data DIR]
 //                 [--work DIR] [--results FILE]
@@ -403,7 +403,8 @@ int main(int argc, char** argv) {
   app.add_option("--data", settings.data, "Data directory (with ycbv_subset)")->capture_default_str();
   app.add_option("--work", settings.work, "Directory for the libraries built (their files are replaced)")
       ->capture_default_str();
-  app.add_option("--results", settings.results, "Markdown file the report is appended to")->capture_default_str();
+  app.add_option("--results", settings.results, "Markdown file whose section of this bench the report replaces")
+      ->capture_default_str();
   if (const auto exit_code = ecv::bench::ParseCommandLine(app, argc, argv)) return *exit_code;
   try {
     fs::create_directories(settings.work);
@@ -475,8 +476,8 @@ int main(int argc, char** argv) {
         " descriptors of the real frame YCB-Video 0001/000001 against every view's matcher (k = 1), or against one "
         "index over all descriptors of the library (LibraryLoadOptions::build_library_index).\n\n" +
         scaling;
-    ecv::bench::Report(settings.results, "Model database: build, size, load, views, scaling (modeldb_bench)",
-                       settings.command, markdown);
+    ecv::bench::ReportSection(settings.results, "Model database: build, size, load, views, scaling (modeldb_bench)",
+                              settings.command, markdown);
     return 0;
   } catch (const std::exception& error) {
     std::cerr << "modeldb_bench: " << error.what() << '\n';

@@ -48,7 +48,8 @@ int Run(int argc, char** argv) {
   bool keep_plane = false;
   app.add_flag("--keep-plane", keep_plane, "Keep the scene's dominant plane's points (a table top)");
   app.add_option("--frames", frames_filter, "Only frames whose name contains this (default: all 30)");
-  app.add_option("--results", results, "Markdown file the report is appended to")->capture_default_str();
+  app.add_option("--results", results, "Markdown file whose section of this bench the report replaces")
+      ->capture_default_str();
   if (const auto exit_code = ParseCommandLine(app, argc, argv)) return *exit_code;
 
   std::map<std::string, PpfModel> models;
@@ -123,7 +124,7 @@ int Run(int argc, char** argv) {
          << " ms per frame (median). In the best 5 per video:";
   for (const auto& [video, counts] : per_video) report << ' ' << video << ' ' << counts[1] << '/' << counts[0];
   report << ".\n\n" << table.str();
-  Report(results, "Point pair features alone on YCB-Video (ppf_bench)", CommandLine(argc, argv), report.str());
+  ReportSection(results, "Point pair features alone on YCB-Video (ppf_bench)", CommandLine(argc, argv), report.str());
   return 0;
 }
 

@@ -5,7 +5,7 @@
 
 Per frame of the 30 YCB-Video frames (videos 0000-0002), frame by frame: the wall time of recognize() on numpy
 arrays (float32 depth in metres, read in place; uint16 depth with depth_scale, converted) and of recognize_frame(),
-each minus the recognizer's own "total" for that call. Prints a markdown table and appends it to bench/RESULTS.md
+each minus the recognizer's own "total" for that call. Prints a markdown table and puts it in bench/RESULTS.md
 with the date, the machine and the command.
 """
 

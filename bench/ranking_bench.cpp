@@ -153,7 +153,8 @@ int Main(int argc, char** argv) {
   app.add_option("--ranking-checks", options.ranking.checks,
                  "Descriptors compared per query when ranking (0: as many as matching)")
       ->capture_default_str();
-  app.add_option("--results", results, "Markdown file the report is appended to")->capture_default_str();
+  app.add_option("--results", results, "Markdown file whose section of this bench the report replaces")
+      ->capture_default_str();
   app.footer(
       "Libraries:\n  scripts/build_ycbv_library YCBV_LIB.sqlite --views 40 --distance 0.9\n"
       "  scripts/build_lmo_library LMO_LIB.sqlite --views 40 --distance 1.0 (with --lmo)");
@@ -172,8 +173,8 @@ int Main(int argc, char** argv) {
               "scene and ranking every view: "
            << Fixed(Median(ms), 0) << ".\n\n"
            << table;
-  Report(results, lmo ? "View ranking on LM-O (ranking_bench)" : "View ranking on YCB-Video (ranking_bench)",
-         CommandLine(argc, argv), markdown.str());
+  ReportSection(results, lmo ? "View ranking on LM-O (ranking_bench)" : "View ranking on YCB-Video (ranking_bench)",
+                CommandLine(argc, argv), markdown.str());
   return 0;
 }
 

@@ -1,8 +1,8 @@
 // ransac_bench: the paper's Table I (prerejective against standard RANSAC at a fixed number of iterations)
 // and the peers (PCL's SampleConsensusPrerejective, Open3D's correspondence RANSAC with its edge-length
 // checker), all fed the same ECV correspondences of two view pairs: a rendered wide-baseline pair and the real
-// YCB-Video pair moved by 30 degrees (issue 6, "Benchmarks"). Prints markdown tables and appends them to
-// bench/RESULTS.md with the date, the machine and the command.
+// YCB-Video pair moved by 30 degrees (issue 6, "Benchmarks"). Prints markdown tables and puts them in
+// bench/RESULTS.md with the date, the machine and the command, in place of the previous run's section.
 //
 //   ransac_bench [--runs N] [--standard-runs N] [--paper-runs N] [--iterations K] [--results FILE] [--no-peers]
 //                [--data DIR] [--python EXE] [--scratch DIR] [--note TEXT]
@@ -421,7 +421,8 @@ int main(int argc, char** argv) {
   app.add_option("--iterations", settings.iterations, "RANSAC iterations (samples drawn) per run")
       ->check(AtLeastOne())
       ->capture_default_str();
-  app.add_option("--results", settings.results, "Markdown file the report is appended to")->capture_default_str();
+  app.add_option("--results", settings.results, "Markdown file whose section of this bench the report replaces")
+      ->capture_default_str();
   app.add_flag_callback(
       "--no-peers", [&settings] { settings.peers = false; }, "Skip the PCL and Open3D peers");
   app.add_option("--data", settings.data, "Data directory (with ycbv_subset)")->capture_default_str();
@@ -445,8 +446,8 @@ int main(int argc, char** argv) {
     const std::string load = "Load average (1 min) " + load_before + " at the start, " + LoadAverage() +
                              " at the end, on " + std::to_string(std::thread::hardware_concurrency()) +
                              " cores shared with other users: wall times grow with the load, CPU times much less.";
-    Report(settings.results, "ransac_bench: prerejective vs standard RANSAC (paper Table I) and peers",
-           settings.command, Markdown(pairs, tables, settings, load));
+    ReportSection(settings.results, "ransac_bench: prerejective vs standard RANSAC (paper Table I) and peers",
+                  settings.command, Markdown(pairs, tables, settings, load));
     return 0;
   } catch (const ecv::InputError& error) {
     std::cerr << "ransac_bench: " << error.what() << '\n';

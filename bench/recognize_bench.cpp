@@ -689,7 +689,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--figure", figure,
                  "Picture of the detections of ours and each peer in the demo frame 0001/000001 (default: none)");
-  app.add_option("--results", results, "Markdown file the report is appended to")->capture_default_str();
+  app.add_option("--results", results, "Markdown file whose section of this bench the report replaces")
+      ->capture_default_str();
   app.add_option("--frames", limit, "Only the first N YCB-Video frames (0: all 30)")->capture_default_str();
   app.add_option("--frame-step", step, "Every S-th YCB-Video frame only (for tuning the peers)")->capture_default_str();
   app.add_option("--ppf-sampling", peer_options.ppf_relative_sampling,
@@ -759,7 +760,8 @@ int main(int argc, char** argv) {
                << RecallTable(lmo_runs);
     }
     if (methods.peers) markdown << '\n' << PeerSettings(peer_options);
-    Report(results, "Recognition on YCB-Video and LM-O (recognize_bench)", CommandLine(argc, argv), markdown.str());
+    ReportSection(results, "Recognition on YCB-Video and LM-O (recognize_bench)", CommandLine(argc, argv),
+                  markdown.str());
   } catch (const std::exception& error) {
     std::cerr << "recognize_bench: " << error.what() << '\n';
     return 1;

@@ -1,15 +1,13 @@
 // render_bench: milliseconds per 640x480 view for the YCB textured meshes (google_16k, 4096^2 textures)
 // with one OSMesa context reused, plus the overlay figure of the cracker box at its ground-truth pose.
-// Prints a markdown table and appends it to bench/RESULTS.md with the date, the machine and the command.
+// Prints a markdown table and puts it in bench/RESULTS.md with the date, the machine and the command, in place of
+// its section of the previous run (bench_util ReportSection).
 //
 //   render_bench [--views N] [--data DIR] [--results FILE] [--figure FILE]
 
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
-#include <cstdio>
-#include <ctime>
-#include <fstream>
 #include <iostream>
 #include <numeric>
 #include <sstream>
@@ -30,7 +28,6 @@ namespace {
 using ecv::Clock;
 using ecv::MillisecondsSince;
 using ecv::bench::Fixed;
-using ecv::bench::MachineDescription;
 
 const char* const kObjects[] = {"003_cracker_box",    "004_sugar_box",   "005_tomato_soup_can",
                                 "006_mustard_bottle", "009_gelatin_box", "010_potted_meat_can"};
@@ -110,7 +107,8 @@ int main(int argc, char** argv) {
       "render_bench"};
   app.add_option("--views", settings.views, "Views rendered per mesh")->capture_default_str();
   app.add_option("--data", settings.data, "Data directory (with ycbv_subset)")->capture_default_str();
-  app.add_option("--results", settings.results, "Markdown file the report is appended to")->capture_default_str();
+  app.add_option("--results", settings.results, "Markdown file whose section of this bench the report replaces")
+      ->capture_default_str();
   app.add_option("--figure", settings.figure, "File the overlay picture is written to")->capture_default_str();
   if (const auto exit_code = ecv::bench::ParseCommandLine(app, argc, argv)) return *exit_code;
   settings.command = "render_bench";  // the arguments as given, without the program's path
@@ -124,18 +122,12 @@ int main(int argc, char** argv) {
         "| mesh | triangles | texture | load ms | upload ms | ms/view median | mean | max | object pixels % |\n"
         "|---|---|---|---|---|---|---|---|---|\n";
     for (const char* object : kObjects) table += BenchmarkMesh(renderer, settings, object, camera);
-    const std::time_t now = std::time(nullptr);
-    char date[32];
-    std::strftime(date, sizeof(date), "%Y-%m-%d %H:%M", std::localtime(&now));
-    const std::string report = "## render_bench, " + std::string(date) + "\n\n- machine: " + MachineDescription() +
-                               "\n- renderer: " + renderer.Description() + " (context created once in " +
-                               Fixed(context_ms, 0) + " ms, reused)\n- command: `" + settings.command + "`\n- " +
-                               std::to_string(settings.views) +
+    const std::string report = "Renderer: " + renderer.Description() + " (context created once in " +
+                               Fixed(context_ms, 0) + " ms, reused). " + std::to_string(settings.views) +
                                " views per mesh, 640x480, YCB-Video intrinsics, Fibonacci lattice over the sphere; "
-                               "ms/view = Render() wall time incl. read-back of colour, depth and labels\n\n" +
-                               table + "\n";
-    std::cout << report;
-    std::ofstream(settings.results, std::ios::app) << report;
+                               "ms/view = Render() wall time incl. read-back of colour, depth and labels.\n\n" +
+                               table;
+    ecv::bench::ReportSection(settings.results, "Rendering the YCB meshes (render_bench)", settings.command, report);
     SaveOverlayFigure(renderer, settings);
     return 0;
   } catch (const std::exception& error) {

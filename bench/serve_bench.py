@@ -6,7 +6,8 @@
 Over the 30 YCB-Video frames (videos 0000-0002), frame by frame, one thread: the wall time of a one-shot
 `recognize` process per frame (library and meshes loaded each time), and of each request answered by one `serve`
 process (its first answer counted from the process's start). Both give the same detections (checked). Prints a
-markdown table and appends it to bench/RESULTS.md with the date, the machine and the command.
+markdown table and puts it in bench/RESULTS.md with the date, the machine and the command, in place of the
+previous run's section.
 """
 
 import argparse

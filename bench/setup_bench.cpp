@@ -4,7 +4,7 @@
 // frame, and `eval`'s model set-up; the library's size either way. The two variants alternate over the rounds and
 // must give the same detections. Peer in the same run: Open3D reading the same mesh files
 // (bench/mesh_load_open3d.py, skipped when Open3D is not installed).
-// Appends a section to bench/RESULTS.md (bench_util Report).
+// Replaces its section of bench/RESULTS.md (bench_util ReportSection).
 //
 //   scripts/build_ycbv_library /tmp/ycbv.sqlite --views 40 --distance 0.9
 //   setup_bench --db /tmp/ycbv.sqlite [--frame YCBV_PREFIX] [--rounds 3] [--threads 2] [--work DIR]
@@ -133,7 +133,8 @@ int main(int argc, char** argv) {
       ->check(ecv::bench::AtLeastOne())
       ->capture_default_str();
   app.add_option("--work", settings.work, "Directory for the library copy without meshes")->capture_default_str();
-  app.add_option("--results", settings.results, "Markdown file the report is appended to")->capture_default_str();
+  app.add_option("--results", settings.results, "Markdown file whose section of this bench the report replaces")
+      ->capture_default_str();
   app.footer("Library:\n  scripts/build_ycbv_library /tmp/ycbv.sqlite --views 40 --distance 0.9");
   if (const auto exit_code = ecv::bench::ParseCommandLine(app, argc, argv)) return *exit_code;
   try {
@@ -192,10 +193,10 @@ int main(int argc, char** argv) {
     } else {
       markdown += " Peer skipped: Open3D is not installed for /usr/bin/python3 (apt-get install -y python3-open3d).";
     }
-    ecv::bench::Report(settings.results,
-                       "Recognizer set-up: meshes stored in the library or read from files "
-                       "(setup_bench)",
-                       settings.command, markdown + "\n");
+    ecv::bench::ReportSection(settings.results,
+                              "Recognizer set-up: meshes stored in the library or read from files "
+                              "(setup_bench)",
+                              settings.command, markdown + "\n");
     return 0;
   } catch (const std::exception& error) {
     std::cerr << "setup_bench: " << error.what() << '\n';

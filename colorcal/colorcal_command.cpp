@@ -31,7 +31,7 @@ struct ColorcalArgs {
   std::string pairs_path;
   std::string method = "ransac";
   // The matrices the recognizer applies before matching: per-channel gains, brightness kept. Measured by
-  // recognize_bench on YCB-Video (bench/RESULTS.md, "Colour calibration: hand pairs and the effect on matching"):
+  // recognize_bench on YCB-Video (bench/EXPERIMENTS.md, 2026-11-22, "colour matrices of other forms"):
   // 30 of 70 objects against 25 without matrices and 21-23 with full or auto-form matrices as fitted.
   std::string form = "diagonal";
   bool keep_brightness = true;

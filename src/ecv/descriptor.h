@@ -44,7 +44,7 @@ enum class DescriptorShape : int {
 };
 
 /// The ECV context descriptor (paper Sect. II-B). Defaults chosen by the correspondence score on YCB-Video videos
-/// 0000 and 0001 (bench/RESULTS.md, "Discriminative power of descriptors", ablations); the paper's own descriptor is
+/// 0000 and 0001 (discriminative_bench's ablations, bench/EXPERIMENTS.md, 2026-11-21); the paper's own descriptor is
 /// soft_binning = false, hellinger = false with the pairs, appearance and weighting below at their defaults and
 /// max_neighbours 0.
 ///
@@ -59,7 +59,7 @@ struct DescriptorOptions {
   /// A segment's direction has no sign: use |cosines| that involve one. A segment's sign follows the image axes
   /// (Primitive::orientation), so signed directions change with the camera's roll about its optical axis and
   /// unsigned ones do not; signed ones find more objects of a camera held level, unsigned ones suit a camera that
-  /// is not (bench/RESULTS.md, "the camera's roll").
+  /// is not (bench/EXPERIMENTS.md, 2026-11-26, "unsigned segment directions").
   bool unsigned_segments = false;
   bool soft_binning = true;  ///< share each value between its two nearest bins (linear)
   bool use_color = true;     ///< false: shape only (the three colour histograms stay zero)
@@ -88,7 +88,7 @@ struct DescriptorOptions {
   /// The context model libraries are built with (FeatureSettings): pairs of the source with each neighbour
   /// (kSource) in 4 radial shells over 4.5 cm. It scores about twice the field defaults' correspondence score at
   /// 1/27 of their time, and finds more objects end to end (bench/RESULTS.md, "Discriminative power of
-  /// descriptors" and "Recognition on YCB-Video and LM-O").
+  /// descriptors"; bench/EXPERIMENTS.md, 2026-11-23, "the paper's all-pairs context").
   static DescriptorOptions SourceShells();
   /// SourceShells() with the surface context for its shape histograms (DescriptorShape::kSurface).
   static DescriptorOptions SurfaceShells();

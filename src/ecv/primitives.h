@@ -30,7 +30,7 @@ struct Primitive {
 };
 
 /// Options of the ECV extraction; defaults chosen by the correspondence score of the context descriptor on
-/// YCB-Video videos 0000 and 0001 (bench/discriminative_bench, ablations in bench/RESULTS.md).
+/// YCB-Video videos 0000 and 0001 (bench/discriminative_bench's ablations, bench/EXPERIMENTS.md, 2026-11-21).
 struct EcvOptions {
   MonogenicOptions monogenic;
   double grid_spacing_px = 5.0;     ///< distance between hexagonal cell centres, pixels

@@ -97,7 +97,7 @@ class BlobReader {
 };
 
 // A texture as its size and its RGB rows compressed with LZ4-HC: about as small as a PNG of YCB's textures and
-// decoded 15x faster (bench/RESULTS.md, setup_bench).
+// decoded 15x faster (bench/EXPERIMENTS.md, 2026-11-25, "textures stored as PNG").
 void WriteTexture(BlobWriter& writer, const cv::Mat& texture, const MeshBlobOptions& options) {
   if (texture.empty()) {
     writer.U32(0);

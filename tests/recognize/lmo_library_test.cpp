@@ -49,9 +49,10 @@ TEST(LmoLibrary, FindsTheCanAndWithPointPairsTheDuckWithoutFalsePositives) {
     if (object.correct) found.push_back(object.model);
   }
   // Not all 8: the floor measured when headlight shading came in (0 of 8 with unlit views), to catch regressions.
-  // The duck (obj_000009) was found as well until session 23, but only with FLANN's matches at exactly 4 trees
-  // and 32 checks: its best views hold at most 5 right correspondences of 200, and with 64 or 128 checks (nearer
-  // neighbours) FLANN lost it too, as does the recognizer's KdForest (bench/RESULTS.md, session 23).
+  // The duck (obj_000009) was found as well until the recognizer took the KdForest (2026-11-24), but only with
+  // FLANN's matches at exactly 4 trees and 32 checks: its best views hold at most 5 right correspondences of 200,
+  // and with 64 or 128 checks (nearer neighbours) FLANN lost it too, as does the recognizer's KdForest
+  // (bench/RESULTS.md, "Recognizer defaults", match).
   EXPECT_EQ(found, std::vector<std::string>({"obj_000005"})) << run.output;
   EXPECT_EQ(evaluation.false_positives, 0) << run.output;
 

@@ -238,7 +238,8 @@ TEST_F(RecognizeEndToEnd, ALibraryWithUnsignedSegmentsFindsTheObjectsOfFramesTur
 // A library whose descriptors use the surface context (DescriptorShape::kSurface) needs no segment's sign, so it
 // finds the objects of frames of video 0001 upright and turned 180 degrees alike (RANSAC seed 1): the two boxes every
 // time, the mustard bottle in at least 4 of the 6 runs (5 here), and at most one false positive. The default library
-// (segments signed by the image axes) finds the mustard bottle in none of the turned frames (session 32).
+// (segments signed by the image axes) finds the mustard bottle in none of the turned frames (bench/EXPERIMENTS.md,
+// 2026-11-26).
 TEST_F(RecognizeEndToEnd, ALibraryWithTheSurfaceContextFindsTheObjectsAtEitherRoll) {
   const ModelLibrary library = LibraryWithSettings("surface", R"({"descriptor": {"shape": 1}})");
   ASSERT_EQ(library.feature_settings().descriptor.shape, DescriptorShape::kSurface);
@@ -294,7 +295,8 @@ TEST_F(RecognizeEndToEnd, WhenEveryModelIsTrackedNoPrimitivesAreExtracted) {
     const GroundTruth* truth = TruthOf(frame, detection.model);
     ASSERT_NE(truth, nullptr);
     // Found at 1.4 mm / 2.0 deg and 5.1 mm / 4.6 deg; ICP from there stays near the truth. (The bottle's turn
-    // about its own axis is weakly held: it is found 4-6 degrees off over seeds, bench/RESULTS.md, session 23.)
+    // about its own axis is weakly held: it is found 4-6 degrees off over seeds, bench/RESULTS.md, "Recognizer
+    // defaults", match.)
     EXPECT_LT(TranslationDistance(detection.camera_from_object, truth->camera_from_object), 0.008) << detection.model;
     EXPECT_LT(RotationAngle(detection.camera_from_object, truth->camera_from_object), 8.0 * M_PI / 180.0)
         << detection.model;
@@ -502,7 +504,7 @@ TEST_F(RecognizeEndToEnd, FindsBothOfTwoMustardBottlesWhenAskedForTwoInstances) 
   // Each bottle is found near its pose, over RANSAC seeds 1-3. Over seeds 1-10, 19 of the 20 bottles were found
   // within 10 mm and 12 degrees; the other one, the demo frame's own bottle with seed 9, turned 178 degrees about
   // its axis (the cap and shoulder alone look alike both ways round). With FLANN's matches instead of the
-  // KdForest's: 20 of 20 (bench/RESULTS.md, session 23).
+  // KdForest's: 20 of 20 (bench/RESULTS.md, "Recognizer defaults", match).
   int near = 0;
   for (const int seed : {1, 2, 3}) {
     FrameEvaluation two;

@@ -418,7 +418,8 @@ TEST_F(YcbvLibrary, PointPairsFindAGreyModelAndReportNoAbsentOne) {
   EXPECT_EQ(both.evaluation.false_positives, 0) << both.output;
   for (const Detection& detection : both.detections) EXPECT_NE(detection.model, "007_tuna_fish_can");
   for (const ObjectEvaluation& object : both.evaluation.objects) {
-    // The grey chef can is not required: verification cannot judge an untextured model's colours (bench/RESULTS.md).
+    // The grey chef can is not required: verification cannot judge an untextured model's colours
+    // (bench/EXPERIMENTS.md, 2026-11-27: one-coloured models).
     if (object.model != "002_master_chef_can") {
       EXPECT_TRUE(object.correct) << object.model << '\n' << both.output;
     }
