@@ -8,7 +8,7 @@
 //   scripts/build_ycbv_library /tmp/ycbv.sqlite --views 40 --distance 0.9               # 7 textured models
 //   scripts/build_ycbv_library --with-untextured /tmp/ycbv16.sqlite --views 40 --distance 0.9
 //   generalisation_bench --db /tmp/ycbv.sqlite [--hypotheses context both] [--seeds 1 2 3] [--track]
-//                        [--rendered 200] [--composites 100] [--split reporting|choosing] [--threads 2]
+//                        [--rendered 200] [--composites 100] [--cast-step 1] [--split reporting|choosing] [--threads 2]
 //                        [--figures bench/figures] [--results bench/RESULTS.md]
 
 #include <CLI/CLI.hpp>
@@ -37,10 +37,10 @@ namespace {
 // What one configuration of the recognizer did on every frame of the set.
 struct Run {
   std::string label;
-  std::vector<FrameEvaluation> evaluations;   // per frame
+  std::vector<FrameEvaluation> evaluations;        // per frame
   std::vector<std::vector<Detection>> detections;  // per frame
-  std::vector<double> ms;                     // per frame
-  std::vector<int> frame_index;               // into the set's frames
+  std::vector<double> ms;                          // per frame
+  std::vector<int> frame_index;                    // into the set's frames
 };
 
 struct Counts {
@@ -283,7 +283,7 @@ struct Settings {
                   figures = std::string(ECV_SOURCE_DIR) + "/bench/figures", split = "reporting", figure_format = "jpg";
   std::vector<std::string> hypotheses = {"context"};
   std::vector<uint64_t> seeds = {1};
-  int rendered = 200, composites = 100, threads = 2;
+  int rendered = 200, composites = 100, threads = 2, cast_step = 1;
   bool track = false;
 };
 
@@ -298,6 +298,8 @@ int Main(int argc, char** argv) {
   app.add_option("--composites", s.composites, "Composites of real frames")->check(CLI::NonNegativeNumber);
   app.add_option("--split", s.split, "Which half: reporting (figures to quote) or choosing (to choose settings on)")
       ->check(CLI::IsMember({"reporting", "choosing"}));
+  app.add_option("--cast-step", s.cast_step, "Every n-th real frame of each video under each cast")
+      ->check(AtLeastOne());
   app.add_option("--threads", s.threads, "Recognizer worker threads")->check(AtLeastOne());
   app.add_flag("--track", s.track, "Also track along the cast videos (recognize --track)");
   app.add_option("--figures", s.figures, "Folder of the pictures (one per set)");
@@ -335,10 +337,41 @@ int Main(int argc, char** argv) {
   std::vector<BenchFrame> frames =
       RenderedFrames(renderer, assets, mesh_ids, LoadBackdrops(backdrop_frames), half, s.rendered);
   for (BenchFrame& frame : CompositeFrames(sources, half, s.composites)) frames.push_back(std::move(frame));
-  for (BenchFrame& frame : CastFrames(sources, half)) frames.push_back(std::move(frame));
+  for (BenchFrame& frame : CastFrames(sources, half, s.cast_step)) frames.push_back(std::move(frame));
   const double generate_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
+  // The section is written after every run, so that a long run reports what it has measured so far.
+  const std::string tag = std::to_string(library.models().size()) + "models";
+  const int planned = static_cast<int>(s.hypotheses.size() * s.seeds.size()) * (s.track ? 2 : 1);
   std::vector<Run> runs;
+  const auto report = [&] {
+    const double total_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::ostringstream text;
+    std::map<std::string, int> per_set;
+    for (const BenchFrame& frame : frames) ++per_set[frame.set];
+    text << "The " << SplitHalfName(half) << " half: " << per_set["rendered"] << " rendered scenes, "
+         << per_set["composite"] << " composites, " << per_set["cast"] << " cast frames; library of "
+         << library.models().size() << " models (`" << s.db << "`), " << s.threads << " threads. Generating took "
+         << Fixed(generate_s, 0) << " s, " << runs.size() << " of " << planned << " runs " << Fixed(total_s / 60.0, 1)
+         << " min in all.\n\n"
+         << ConditionTable(runs, frames) << "\nWhere the false positives lie (nearest object within 6 cm; the "
+         << "same object within 10 cm), and the objects by side: plain when the mean grey gradient over the "
+         << "visible pixels is under " << kPlainGradient << " (grey objects counted apart).\n\n"
+         << FailureTable(runs, frames, library_models, grey) << "\nPer object and set (rend, comp, cast):\n\n"
+         << ObjectTable(runs, frames) << "\nDetections digest (equal digests: the same detections):";
+    for (const Run& run : runs) text << " " << run.label << " `" << Digest(run) << "`;";
+    text << "\n\nPictures: `bench/figures/generalisation_<set>_" << tag << ".jpg`.\n";
+    ReportSection(s.results,
+                  "Generalisation set (" + std::string(SplitHalfName(half)) + " half, " +
+                      std::to_string(library.models().size()) + " models)",
+                  CommandLine(argc, argv), text.str());
+  };
+  const auto add_run = [&](Run run) {
+    runs.push_back(std::move(run));
+    if (runs.size() == 1 && !s.figures.empty())
+      WriteFigures(library, runs.front(), frames, s.figures, tag, s.figure_format);
+    report();
+  };
   for (const std::string& source : s.hypotheses) {
     for (const uint64_t seed : s.seeds) {
       RecognizerOptions options;
@@ -346,33 +379,10 @@ int Main(int argc, char** argv) {
       options.ransac.seed = seed;
       options.ransac.threads = s.threads;
       const std::string label = source + ", seed " + std::to_string(seed);
-      runs.push_back(RunRecognizer(library, options, frames, models, label, false));
-      if (s.track) runs.push_back(RunRecognizer(library, options, frames, models, label + ", --track", true));
+      add_run(RunRecognizer(library, options, frames, models, label, false));
+      if (s.track) add_run(RunRecognizer(library, options, frames, models, label + ", --track", true));
     }
   }
-  const double total_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-
-  const std::string tag = std::to_string(library.models().size()) + "models";
-  if (!s.figures.empty() && !runs.empty()) WriteFigures(library, runs.front(), frames, s.figures, tag, s.figure_format);
-
-  std::ostringstream report;
-  std::map<std::string, int> per_set;
-  for (const BenchFrame& frame : frames) ++per_set[frame.set];
-  report << "The " << SplitHalfName(half) << " half: " << per_set["rendered"] << " rendered scenes, "
-         << per_set["composite"] << " composites, " << per_set["cast"] << " cast frames; library of "
-         << library.models().size() << " models (`" << s.db << "`), " << s.threads << " threads. Generating took "
-         << Fixed(generate_s, 0) << " s, the whole run " << Fixed(total_s / 60.0, 1) << " min.\n\n"
-         << ConditionTable(runs, frames) << "\nWhere the false positives lie (nearest object within 6 cm; the "
-         << "same object within 10 cm), and the objects by side: plain when the mean grey gradient over the "
-         << "visible pixels is under " << kPlainGradient << " (grey objects counted apart).\n\n"
-         << FailureTable(runs, frames, library_models, grey) << "\nPer object and set (rend, comp, cast):\n\n"
-         << ObjectTable(runs, frames) << "\nDetections digest (equal digests: the same detections):";
-  for (const Run& run : runs) report << " " << run.label << " `" << Digest(run) << "`;";
-  report << "\n\nPictures: `bench/figures/generalisation_<set>_" << tag << ".jpg`.\n";
-  ReportSection(s.results,
-                "Generalisation set (" + std::string(SplitHalfName(half)) + " half, " + tag.substr(0, tag.size() - 6) +
-                    " models)",
-                CommandLine(argc, argv), report.str());
   return 0;
 }
 

@@ -12,12 +12,9 @@ namespace {
 
 // The look-alikes of YCB-Video that real frames show: the object cut, and the one it is placed beside.
 const std::vector<std::pair<std::string, std::string>> kLookAlikes = {
-    {"009_gelatin_box", "010_potted_meat_can"},
-    {"009_gelatin_box", "008_pudding_box"},
-    {"008_pudding_box", "009_gelatin_box"},
-    {"010_potted_meat_can", "009_gelatin_box"},
-    {"036_wood_block", "003_cracker_box"},
-    {"061_foam_brick", "010_potted_meat_can"},
+    {"009_gelatin_box", "010_potted_meat_can"}, {"009_gelatin_box", "008_pudding_box"},
+    {"008_pudding_box", "009_gelatin_box"},     {"010_potted_meat_can", "009_gelatin_box"},
+    {"036_wood_block", "003_cracker_box"},      {"061_foam_brick", "010_potted_meat_can"},
 };
 
 std::string VideoOf(const std::string& prefix) {
@@ -26,7 +23,9 @@ std::string VideoOf(const std::string& prefix) {
   return prefix.substr(before + 1, slash - before - 1);
 }
 
-std::string FrameOf(const std::string& prefix) { return prefix.substr(prefix.rfind('/') + 1); }
+std::string FrameOf(const std::string& prefix) {
+  return prefix.substr(prefix.rfind('/') + 1);
+}
 
 bool HasObject(const LoadedFrame& frame, const std::string& name) {
   return std::any_of(frame.ground_truth.begin(), frame.ground_truth.end(),
@@ -35,7 +34,8 @@ bool HasObject(const LoadedFrame& frame, const std::string& name) {
 
 std::vector<SceneObjectInfo> ObjectsOf(const std::vector<GroundTruth>& truth) {
   std::vector<SceneObjectInfo> objects;
-  for (const GroundTruth& object : truth) objects.push_back({object.object_name, object.camera_from_object.translation()});
+  for (const GroundTruth& object : truth)
+    objects.push_back({object.object_name, object.camera_from_object.translation()});
   return objects;
 }
 
@@ -48,7 +48,9 @@ std::vector<cv::Mat> ClassMasks(const cv::Mat& labels, const std::vector<GroundT
 
 }  // namespace
 
-const char* SplitHalfName(SplitHalf half) { return half == SplitHalf::kChoosing ? "choosing" : "reporting"; }
+const char* SplitHalfName(SplitHalf half) {
+  return half == SplitHalf::kChoosing ? "choosing" : "reporting";
+}
 
 std::vector<std::string> SplitVideos(SplitHalf half) {
   // 0002 holds the most objects and three of the grey ones: settings are chosen on it; 0000 and 0001 report.
@@ -92,8 +94,8 @@ std::vector<std::pair<std::string, ColorCast>> SetCasts() {
 }
 
 std::vector<BenchFrame> RenderedFrames(Renderer& renderer, const std::vector<SceneAsset>& assets,
-                                       const std::vector<MeshId>& mesh_ids, const Backdrops& backdrops,
-                                       SplitHalf half, int count) {
+                                       const std::vector<MeshId>& mesh_ids, const Backdrops& backdrops, SplitHalf half,
+                                       int count) {
   std::vector<BenchFrame> frames;
   for (int i = 0; i < count; ++i) {
     const uint32_t seed = SplitSeed(half, i);
@@ -159,11 +161,15 @@ std::vector<BenchFrame> CompositeFrames(const std::vector<SourceFrame>& sources,
                            &composite);
     }
     if (!made) continue;
-    BenchFrame bench{"composite", look_alike ? "beside a look-alike" : "another room", "",
+    BenchFrame bench{"composite",
+                     look_alike ? "beside a look-alike" : "another room",
+                     "",
                      "composite/" + std::to_string(seed) + " " + composite.object_name + " from " +
                          VideoOf(composite.source_prefix) + "/" + FrameOf(composite.source_prefix) + " into " +
                          VideoOf(composite.target_prefix) + "/" + FrameOf(composite.target_prefix),
-                     std::move(composite.frame), {}, {}};
+                     std::move(composite.frame),
+                     {},
+                     {}};
     bench.plain = PlainObjects(bench.frame.rgbd.color, ClassMasks(composite.labels, bench.frame.ground_truth));
     bench.objects = ObjectsOf(bench.frame.ground_truth);
     std::cerr << "\rcomposites (" << SplitHalfName(half) << "): " << i + 1 << " of " << count << std::flush;
@@ -173,17 +179,20 @@ std::vector<BenchFrame> CompositeFrames(const std::vector<SourceFrame>& sources,
   return frames;
 }
 
-std::vector<BenchFrame> CastFrames(const std::vector<SourceFrame>& sources, SplitHalf half) {
+std::vector<BenchFrame> CastFrames(const std::vector<SourceFrame>& sources, SplitHalf half, int step) {
   const std::vector<std::string> videos = SplitVideos(half);
   std::vector<BenchFrame> frames;
   for (const auto& [name, cast] : SetCasts()) {
+    std::map<std::string, int> taken;  // per video: frames seen
     for (const SourceFrame& source : sources) {
       const std::string video = VideoOf(source.prefix);
       if (std::find(videos.begin(), videos.end(), video) == videos.end()) continue;
+      if (taken[video]++ % std::max(step, 1) != 0) continue;
       LoadedFrame frame{WithColorCast(source.frame.rgbd, cast), source.frame.ground_truth, source.frame.scene_id,
                         source.frame.image_id};
-      BenchFrame bench{"cast", name, video + ", " + name, video + "/" + FrameOf(source.prefix) + ", " + name,
-                       std::move(frame), {}, {}};
+      BenchFrame bench{
+          "cast", name, video + ", " + name, video + "/" + FrameOf(source.prefix) + ", " + name, std::move(frame),
+          {},     {}};
       // Plain by the frame's own light: a cast does not make a printed side plain.
       bench.plain = PlainObjects(source.frame.rgbd.color, ClassMasks(source.labels, source.frame.ground_truth));
       bench.objects = ObjectsOf(source.frame.ground_truth);

@@ -59,16 +59,16 @@ std::vector<std::pair<std::string, ColorCast>> SetCasts();
 /// `count` rendered scenes of `half` (seeds SplitSeed(half, 0 .. count - 1)); condition: the light's colour
 /// ("warm", "cool", "neutral" by its red against blue gain) and "dark" when its strength is below 0.7.
 std::vector<BenchFrame> RenderedFrames(Renderer& renderer, const std::vector<SceneAsset>& assets,
-                                       const std::vector<MeshId>& mesh_ids, const Backdrops& backdrops,
-                                       SplitHalf half, int count);
+                                       const std::vector<MeshId>& mesh_ids, const Backdrops& backdrops, SplitHalf half,
+                                       int count);
 
 /// `count` composites of `half` from `sources` (every real frame): half of them a look-alike placed beside the
 /// object it is confused with (condition "beside a look-alike"), the others an object of one video anywhere on the
 /// table of another ("another room").
 std::vector<BenchFrame> CompositeFrames(const std::vector<SourceFrame>& sources, SplitHalf half, int count);
 
-/// The real frames of `half`'s videos under each of SetCasts() (condition: the cast's name; one stream per video
-/// and cast).
-std::vector<BenchFrame> CastFrames(const std::vector<SourceFrame>& sources, SplitHalf half);
+/// Every `step`-th real frame of each of `half`'s videos under each of SetCasts() (condition: the cast's name; one
+/// stream per video and cast).
+std::vector<BenchFrame> CastFrames(const std::vector<SourceFrame>& sources, SplitHalf half, int step = 1);
 
 }  // namespace ecv::bench
