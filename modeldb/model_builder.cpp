@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/parallel.h"
 #include "core/timing.h"
 #include "io/mesh_io.h"
 #include "modeldb/content_hash.h"
@@ -73,7 +74,7 @@ void ModelBuildOptions::Check() const {
   features.descriptor.Check();
   mesh_blob.Check();
   point_pair_sampling.Check();
-  if (threads < 1) ThrowInputError("model build options", "threads", "at least 1", std::to_string(threads));
+  CheckThreadCount("model build options", threads);
 }
 
 double ViewDistance(const BoundingSphere& sphere, const ModelBuildOptions& options) {

@@ -27,15 +27,15 @@ struct ModelBuildOptions {
   /// Camera distance from the object centre, metres; farther when the object would not fit the image with the
   /// margin; 0 = as close as it fits. 0.9 m is about where YCB-Video sees its objects: primitives then have the
   /// scene's density and image scale (as close as fits, small objects give dense views that take many times
-  /// longer to describe and store, and matched real frames worse: bench/RESULTS.md). Every benchmark figure is
-  /// measured with this and DefaultSampling's 40 views.
+  /// longer to describe and store, and matched real frames worse: bench/RESULTS.md, modeldb_bench, and
+  /// bench/EXPERIMENTS.md, 2026-11-21). Every benchmark figure is measured with this and DefaultSampling's 40 views.
   double distance_m = 0.9;
   PinholeCamera camera = YcbVideoCamera();  ///< intrinsics and image size of every view (stored per view)
   RenderOptions render;                     ///< shading etc. (unlit: the texture's colours as stored)
   /// Beyond the paper: BuildModel renders a mesh without any texture (vertex or material colours only) with
   /// headlight shading even when `render.shading` is unlit. A camera sees such an object's form through its
   /// shading; flat colours show little but the silhouette (it finds more of the LM-O frame's scanned models:
-  /// bench/RESULTS.md). Textured meshes keep their texture as stored.
+  /// bench/EXPERIMENTS.md, 2026-11-23). Textured meshes keep their texture as stored.
   /// The recognizer renders each model in verification as its views were (StoredViewShading).
   bool shade_untextured = true;
   FeatureSettings features;  ///< extraction and descriptor settings
@@ -48,7 +48,7 @@ struct ModelBuildOptions {
   /// small, flat or coarse for them is stored without, with a warning.
   bool point_pairs = true;
   PpfModelSampling point_pair_sampling;
-  int threads = 1;  ///< worker threads describing each view (ComputeDescriptors); the model does not depend on it
+  int threads = 1;  ///< worker threads describing each view (1 to kMaxThreads); the model does not depend on it
 
   /// Throws InputError naming the field for nonsense values (via the parts' Check()).
   void Check() const;

@@ -94,8 +94,9 @@ class ModelDatabase {
   /// meanwhile is either seen entirely or not at all. Throws InputError naming an unknown model.
   std::vector<StoredModel> LoadModels(const std::vector<std::string>& names = {}) const;
 
-  /// SQLite's integrity and foreign-key checks, stored counts against the rows, view and primitive numbering,
-  /// and (when `check_descriptors`) the digests of every model's descriptors and stored mesh.
+  /// SQLite's integrity and foreign-key checks, stored counts against the rows, view and primitive numbering, the
+  /// stored values (rigid poses, a finite diameter, view cameras), and (when `check_descriptors`) the digests of
+  /// every model's descriptors and stored mesh.
   VerifyReport Verify(bool check_descriptors = true) const;
 
  private:

@@ -2,9 +2,13 @@
 // verifying a library's consistency.
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
+#include <functional>
 
+#include "core/camera.h"
 #include "core/error.h"
+#include "core/pose.h"
 #include "modeldb/content_hash.h"
 #include "modeldb/model_database.h"
 #include "modeldb/model_database_impl.h"
@@ -167,6 +171,46 @@ void CheckMeshDigests(SqlConnection& connection, std::vector<std::string>* probl
   }
 }
 
+// InputError naming `source` and `field` unless `text` is a rigid 4x4 transform (as written: to rounding).
+void CheckStoredPose(const std::string& text, const std::string& source, const std::string& field) {
+  RigidFromMatrix(PoseFromText(text, source + ": " + field).matrix(), source, field, 1e-6);
+}
+
+// The values a load needs, row by row: rigid poses, a finite diameter > 0, view cameras with finite intrinsics and a
+// positive size. Each bad value is one problem naming its model, view and field.
+void CheckStoredValues(SqlConnection& connection, std::vector<std::string>* problems) {
+  const auto note = [problems](const std::function<void()>& check) {
+    try {
+      check();
+    } catch (const InputError& error) {
+      problems->push_back(error.what());
+    }
+  };
+  SqlStatement models = connection.Prepare("SELECT name, object_from_mesh, diameter_m FROM models ORDER BY name");
+  while (models.Step()) {
+    const std::string model = "model " + models.Text(0);
+    note([&] { CheckStoredPose(models.Text(1), model, "object_from_mesh"); });
+    const double diameter = models.Double(2);
+    if (!std::isfinite(diameter) || diameter <= 0.0) {
+      problems->push_back(model + ": diameter_m: expected a finite size > 0 m, got " + std::to_string(diameter));
+    }
+  }
+  SqlStatement views = connection.Prepare(
+      "SELECT m.name, v.view_index, v.camera_from_object, v.fx, v.fy, v.cx, v.cy, v.width, v.height FROM views v "
+      "JOIN models m ON m.id = v.model_id ORDER BY m.name, v.view_index");
+  while (views.Step()) {
+    const std::string view = "model " + views.Text(0) + " view " + std::to_string(views.Int(1));
+    note([&] { CheckStoredPose(views.Text(2), view, "camera_from_object"); });
+    const PinholeCamera camera{views.Double(3),
+                               views.Double(4),
+                               views.Double(5),
+                               views.Double(6),
+                               static_cast<int>(views.Int(7)),
+                               static_cast<int>(views.Int(8))};
+    note([&] { camera.Check(view + ": camera"); });
+  }
+}
+
 }  // namespace
 
 std::vector<StoredModel> ModelDatabase::LoadModels(const std::vector<std::string>& names) const {
@@ -203,6 +247,7 @@ VerifyReport ModelDatabase::Verify(bool check_descriptors) const {
                   "FROM pragma_foreign_key_check",
                   "foreign key: ", &report.problems);
   CheckCounts(connection, &report.problems);
+  CheckStoredValues(connection, &report.problems);
   SqlStatement counts = connection.Prepare(
       "SELECT (SELECT count(*) FROM models), (SELECT count(*) FROM views), (SELECT count(*) FROM primitives), "
       "(SELECT count(*) FROM descriptors)");

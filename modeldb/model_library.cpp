@@ -29,7 +29,7 @@ void BuildMatchers(std::vector<LibraryModel>* models, const LibraryLoadOptions& 
 
 void LibraryLoadOptions::Check() const {
   match.Check();
-  if (threads < 1) ThrowInputError("library load options", "threads", "at least 1", std::to_string(threads));
+  CheckThreadCount("library load options", threads);
 }
 
 ModelLibrary ModelLibrary::Load(const ModelDatabase& database, const LibraryLoadOptions& options) {

@@ -19,7 +19,7 @@ struct LibraryLoadOptions {
   /// the nearest library descriptors whatever the library's size, e.g. to vote for candidate models and views.
   bool build_library_index = false;
   MatchOptions match;  ///< settings of those matchers
-  int threads = 1;     ///< threads building the matchers (>= 1)
+  int threads = 1;     ///< threads building the matchers (1 to kMaxThreads)
 
   void Check() const;
 };

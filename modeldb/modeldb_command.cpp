@@ -345,7 +345,7 @@ void AddBuildFlags(CLI::App& build, ModeldbArgs* args) {
   build
       .add_option("--threads", args->threads,
                   "Worker threads describing each view (the same library for any count; default: all cores)")
-      ->check(AtLeastOne());
+      ->check(ThreadCount());
   build.add_flag("--no-stored-mesh", args->no_stored_mesh,
                  "Do not store the meshes in the library: recognition then reads each mesh file (mesh_path)");
   build.add_flag("--no-ppf", args->no_point_pairs,

@@ -11,6 +11,37 @@ namespace ecv {
 namespace {
 
 constexpr const char* kSource = "request";
+// A bound on RequestLimits::max_depth, far below the nesting that exhausts the stack.
+constexpr int kDeepestLimit = 1000;
+
+// Whether [ and { nest deeper than `max_depth` in `line`, strings aside: a scan, so that a deep line is refused
+// before anything recurses over it.
+bool NestedDeeperThan(const std::string& line, int max_depth) {
+  int depth = 0;
+  bool in_string = false, escaped = false;
+  for (const char c : line) {
+    if (in_string) {
+      if (escaped) {
+        escaped = false;
+      } else if (c == '\\') {
+        escaped = true;
+      } else if (c == '"') {
+        in_string = false;
+      }
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > max_depth) return true;
+    } else if ((c == ']' || c == '}') && depth > 0) {
+      --depth;
+    }
+  }
+  return false;
+}
+
+std::string TooLongMessage(size_t max_bytes) {
+  return std::string(kSource) + ": JSON: expected a line of at most " + std::to_string(max_bytes) + " bytes";
+}
 
 StreamOptions Tracking(StreamOptions stream) {
   stream.track = true;
@@ -60,13 +91,27 @@ bool Flag(const nlohmann::json& request, const char* key, bool otherwise) {
 
 }  // namespace
 
-RecognitionService::RecognitionService(Recognizer& recognizer, const StreamOptions& stream)
-    : recognizer_(recognizer), track_by_default_(stream.track), stream_(recognizer, Tracking(stream)) {}
+void RequestLimits::Check() const {
+  if (max_bytes < 1) ThrowInputError("request limits", "max_bytes", "at least 1", std::to_string(max_bytes));
+  if (max_depth < 1 || max_depth > kDeepestLimit) {
+    ThrowInputError("request limits", "max_depth", "1 to " + std::to_string(kDeepestLimit), std::to_string(max_depth));
+  }
+}
+
+RecognitionService::RecognitionService(Recognizer& recognizer, const StreamOptions& stream, const RequestLimits& limits)
+    : recognizer_(recognizer), track_by_default_(stream.track), limits_(limits), stream_(recognizer, Tracking(stream)) {
+  limits_.Check();
+}
 
 nlohmann::json RecognitionService::Handle(const std::string& line) {
   nlohmann::json request;
   nlohmann::json id;
   try {
+    if (line.size() > limits_.max_bytes) return {{"id", nullptr}, {"error", TooLongMessage(limits_.max_bytes)}};
+    if (NestedDeeperThan(line, limits_.max_depth)) {
+      ThrowInputError(kSource, "JSON", "[ and { nested at most " + std::to_string(limits_.max_depth) + " deep",
+                      "deeper");
+    }
     try {
       request = nlohmann::json::parse(line);
     } catch (const nlohmann::json::exception& error) {
@@ -78,6 +123,14 @@ nlohmann::json RecognitionService::Handle(const std::string& line) {
   } catch (const InputError& error) {
     return {{"id", id}, {"error", error.what()}};
   }
+}
+
+std::string RecognitionService::Answer(const std::string& line) {
+  return Handle(line).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+std::string RecognitionService::AnswerTooLong() const {
+  return nlohmann::json{{"id", nullptr}, {"error", TooLongMessage(limits_.max_bytes)}}.dump();
 }
 
 nlohmann::json RecognitionService::Respond(const nlohmann::json& request) {

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstddef>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -9,6 +10,15 @@
 
 namespace ecv {
 
+/// Bounds on one request line, checked before it is parsed: a line past them gets an error answer.
+struct RequestLimits {
+  size_t max_bytes = size_t{64} << 20;  ///< bytes of one line (64 MiB: room for a frame's images in base64)
+  int max_depth = 64;                   ///< nesting of [ and { (the serialiser recurses once per level)
+
+  /// Throws InputError for a bound < 1.
+  void Check() const;
+};
+
 /// The requests of `ecvpose serve`, one JSON object per line, and their responses: the rules of the protocol without
 /// its input and output, so that they are tested alone.
 ///
@@ -16,15 +26,24 @@ namespace ecv {
 /// "depth_scale": S, "camera": [fx, fy, cx, cy]}`, with optional `"id"` (any JSON value, echoed), `"track"` (follow
 /// the objects of the previous tracked request; default: the service's) and `"reset": true` (forget the tracks
 /// first). The response is the detections as `recognize --out-json` writes them, with `"id"` and `"frame"`, or
-/// `{"id": ..., "error": MESSAGE}` for a request that is malformed or whose frame cannot be read.
+/// `{"id": ..., "error": MESSAGE}` for a request that is malformed, past `limits` or whose frame cannot be read.
 class RecognitionService {
  public:
   /// `recognizer` must outlive the service. `stream`: whether requests track by default, and the search schedule
   /// of tracked requests.
-  RecognitionService(Recognizer& recognizer, const StreamOptions& stream);
+  RecognitionService(Recognizer& recognizer, const StreamOptions& stream, const RequestLimits& limits = {});
 
   /// The response to one request line.
   nlohmann::json Handle(const std::string& line);
+
+  /// The response line to one request line: Handle's JSON as text, without a newline, always valid UTF-8 (bytes of
+  /// the request that are not, echoed in a message, become U+FFFD).
+  std::string Answer(const std::string& line);
+
+  /// The response line to a request line longer than limits().max_bytes, which the caller did not keep.
+  std::string AnswerTooLong() const;
+
+  const RequestLimits& limits() const { return limits_; }
 
   /// Forgets the tracks: a new client.
   void Reset() { stream_.Reset(); }
@@ -34,6 +53,7 @@ class RecognitionService {
 
   Recognizer& recognizer_;
   bool track_by_default_;
+  RequestLimits limits_;
   RecognitionStream stream_;  // of the tracked requests
 };
 

@@ -78,7 +78,7 @@ void AddSearchFlags(CLI::App& command, RecognizerOptions& options) {
                   "Worker threads for describing the scene and searching the models, one model each (same result for "
                   "any count)")
       ->capture_default_str()
-      ->check(AtLeastOne());
+      ->check(ThreadCount());
   command.add_flag(
       "--no-icp", [o = &options](int64_t) { o->refine = false; }, "Skip the ICP refinement");
 }

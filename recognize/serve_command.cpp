@@ -18,6 +18,7 @@
 #include <thread>
 
 #include "app/commands.h"
+#include "app/frame_args.h"
 #include "core/error.h"
 #include "io/files.h"
 #include "recognize/recognition_service.h"
@@ -25,8 +26,6 @@
 
 namespace ecv::app {
 namespace {
-
-constexpr size_t kMaxRequestBytes = 1 << 20;  // a request names files: a longer line is refused, not buffered
 
 volatile std::sig_atomic_t stop_requested = 0;
 
@@ -45,30 +44,31 @@ void InstallStopHandlers() {
 struct ServeArgs {
   RecognizerArgs recognizer;
   std::string socket;
+  RequestLimits limits;
 };
 
 // Lines of a file descriptor, read as they arrive; nothing once the input ends or a stop is requested.
 class LineReader {
  public:
-  explicit LineReader(int fd) : fd_(fd) {}
+  LineReader(int fd, size_t max_bytes) : fd_(fd), max_bytes_(max_bytes) {}
 
-  // The next line (without its newline); `too_long` is set for a line past kMaxRequestBytes, whose rest is skipped.
+  // The next line (without its newline); `too_long` is set for a line past `max_bytes`, which is skipped (returned
+  // empty) without being kept whole.
   std::optional<std::string> Next(bool* too_long) {
-    *too_long = false;
     while (true) {
-      const size_t newline = buffer_.find('\n');
+      const size_t newline = buffer_.find('\n', scanned_);
       if (newline != std::string::npos) {
-        std::string line = buffer_.substr(0, newline);
+        *too_long = skipping_ || newline > max_bytes_;
+        std::string line = *too_long ? std::string() : buffer_.substr(0, newline);
         buffer_.erase(0, newline + 1);
-        if (skipping_) {
-          skipping_ = false;
-          *too_long = true;
-          return std::string();
-        }
+        scanned_ = 0;
+        skipping_ = false;
         return line;
       }
-      if (buffer_.size() > kMaxRequestBytes) {
+      scanned_ = buffer_.size();  // a long line is searched for its newline once, not once per chunk
+      if (buffer_.size() > max_bytes_) {
         buffer_.clear();
+        scanned_ = 0;
         skipping_ = true;
       }
       char chunk[65536];
@@ -81,20 +81,19 @@ class LineReader {
 
  private:
   int fd_;
+  size_t max_bytes_;
   std::string buffer_;
+  size_t scanned_ = 0;  // bytes of buffer_ known to hold no newline
   bool skipping_ = false;
 };
 
 // Answers the requests of one client, a line each, until its input ends, it goes or a stop is requested.
 void ServeClient(int in, int out, RecognitionService& service) {
-  LineReader reader(in);
+  LineReader reader(in, service.limits().max_bytes);
   bool too_long = false;
   while (const std::optional<std::string> line = reader.Next(&too_long)) {
     if (!too_long && line->find_first_not_of(" \t\r") == std::string::npos) continue;
-    const nlohmann::json response =
-        too_long ? nlohmann::json{{"id", nullptr}, {"error", "request: expected a line of at most 1 MiB"}}
-                 : service.Handle(*line);
-    const std::string text = response.dump() + "\n";
+    const std::string text = (too_long ? service.AnswerTooLong() : service.Answer(*line)) + "\n";
     if (!WriteAll(out, text.data(), text.size()) || stop_requested) return;
   }
 }
@@ -151,7 +150,7 @@ void ServeSocket(const std::string& path, RecognitionService& service) {
 int RunServe(const ServeArgs& args) {
   const RecognizerOptions options = RecognizerOptionsFromArgs(args.recognizer);
   const LoadedRecognizer loaded = LoadRecognizer(args.recognizer, options, "serve");
-  RecognitionService service(*loaded.recognizer, args.recognizer.stream);
+  RecognitionService service(*loaded.recognizer, args.recognizer.stream, args.limits);
   InstallStopHandlers();
   if (!args.socket.empty()) {
     ServeSocket(args.socket, service);
@@ -171,11 +170,17 @@ CommandAction SetupServeCommand(CLI::App& command) {
   command.add_option("--socket", args->socket,
                      "Serve a Unix socket at this path, one client at a time, each with tracks of its own (default: "
                      "standard input and output)");
+  command
+      .add_option("--max-request-bytes", args->limits.max_bytes,
+                  "Longest request line, bytes: a longer one gets an error answer and is skipped, not kept")
+      ->capture_default_str()
+      ->check(AtLeastOne());
   command.footer(
       "Requests, one JSON object per line: {\"frame\": FRAME} or {\"color\": PATH, \"depth\": PATH, \"depth_scale\": "
       "S,\n\"camera\": [fx, fy, cx, cy]}, with optional \"id\" (echoed), \"track\": true|false (default: --track) and "
       "\"reset\": true.\nEach gets one line: the detections as `recognize --out-json` writes them, or {\"id\": ..., "
-      "\"error\": ...}.\nSIGTERM ends the service after the request in hand (exit 0). Protocol: docs/serve.md.");
+      "\"error\": ...}\n(also for a line past --max-request-bytes, nested deeper than 64 or not UTF-8); the service "
+      "goes on.\nSIGTERM ends the service after the request in hand (exit 0). Protocol: docs/serve.md.");
   return [args] { return RunServe(*args); };
 }
 

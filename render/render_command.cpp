@@ -239,8 +239,12 @@ CommandAction SetupRenderCommand(CLI::App& command) {
   AddFrameFlags(command, &args->frame);
   command.add_option("--views", args->views, "Number of viewpoints spread over the sphere (or --elevation band)");
   command.add_option("--out", args->out_dir, "Folder for PNGs (colour, 16-bit depth, mask) and JSON per view");
-  command.add_option("--width", args->width, "Image width, pixels")->capture_default_str()->check(AtLeastOne());
-  command.add_option("--height", args->height, "Image height, pixels")->capture_default_str()->check(AtLeastOne());
+  command.add_option("--width", args->width, "Image width, pixels")
+      ->capture_default_str()
+      ->check(OneTo(kMaxRenderSide));
+  command.add_option("--height", args->height, "Image height, pixels")
+      ->capture_default_str()
+      ->check(OneTo(kMaxRenderSide));
   AddMeshFlags(command, &args->mesh);
   command.add_option("--shading", args->shading, "unlit (surface colours as stored) or headlight")
       ->check(CLI::IsMember({"unlit", "headlight"}))

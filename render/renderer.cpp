@@ -1,5 +1,6 @@
 #include "render/renderer.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -205,6 +206,7 @@ RenderResult Renderer::Impl::RenderScene(const std::vector<SceneObject>& objects
   const gl::Functions& gl = context_.functions();
   GLint max_size = 0;
   gl.GetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_size);
+  max_size = std::min<GLint>(max_size, kMaxRenderSide);
   if (camera.width > max_size || camera.height > max_size) {
     ThrowInputError("render camera", "width/height", "at most " + std::to_string(max_size) + " pixels",
                     std::to_string(camera.width) + "x" + std::to_string(camera.height));

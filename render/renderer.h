@@ -20,6 +20,10 @@ class RenderError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// The largest image side a Renderer renders, pixels (less where the GL implementation's renderbuffers are smaller).
+/// 8192 x 8192 takes about 3 GB while rendering; OSMesa crashes on 16384 x 16384.
+constexpr int kMaxRenderSide = 8192;
+
 /// Settings fixed for the life of a Renderer.
 struct RendererOptions {
   bool mipmaps = true;          ///< trilinear texture filtering; mipmaps are built once, in AddMesh
@@ -99,7 +103,8 @@ class Renderer {
   /// Frees what AddMesh uploaded; `mesh` becomes invalid.
   void RemoveMesh(MeshId mesh);
 
-  /// Renders one mesh at `camera_from_object` (metres) for `camera`.
+  /// Renders one mesh at `camera_from_object` (metres) for `camera`. Throws InputError, before allocating, for an
+  /// image side beyond kMaxRenderSide.
   RenderResult Render(MeshId mesh, const PinholeCamera& camera, const Eigen::Isometry3d& camera_from_object,
                       const RenderOptions& options = {});
 

@@ -25,7 +25,7 @@ allow_missing_textures: build with default colours where a texture or material f
 views, distance: rendered views per model, and their distance from the object centre in metres.
 camera, size: the views' 3x3 intrinsics (default: YCB-Video's) and (width, height).
 shading: "auto", "unlit" or "headlight".
-threads: worker threads (0: every core); the library is the same for any count.
+threads: worker threads, 0 (every core) or 1 to 256; the library is the same for any count.
 stored_mesh, mesh_texture_size: store each mesh in the library (textures at most this many pixels a side).
 point_pairs: store each model's point pair points (shape-driven hypotheses; False: as `--no-ppf`).
 feature_settings: a dict of extraction and descriptor settings as `ecvpose modeldb info` shows them.
@@ -36,7 +36,7 @@ Returns the names of the models built. Raises InputError naming each model that 
 inline constexpr const char* kRecognizerDoc = R"(Recognizer(library, **options): a recognizer over `library`.
 
 The options are the flags of `ecvpose recognize` with underscores, with the same defaults:
-threads=2, seed=1: worker threads (the result is the same for any count) and the random seed.
+threads=2, seed=1: worker threads, 1 to 256 (the result is the same for any count), and the random seed.
 track=False: follow objects from call to call (each previous detection tried first at its pose);
 search_every=1: with track, models not followed are searched on every N-th call only;
 track_score=0.3: a detection is followed only while it scores at least this;

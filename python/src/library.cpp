@@ -2,6 +2,7 @@
 
 #include "library.h"
 
+#include <algorithm>
 #include <thread>
 
 #include <pybind11/functional.h>
@@ -10,6 +11,7 @@
 #include "arrays.h"
 #include "bindings.h"
 #include "core/error.h"
+#include "core/parallel.h"
 #include "io/pose_io.h"
 #include "modeldb/library_build.h"
 #include "modeldb/mesh_sources.h"
@@ -72,8 +74,12 @@ ModelBuildOptions BuildOptions(const BuildArguments& args) {
   if (args.views < 1) ThrowInputError("views", "", "a whole number >= 1", std::to_string(args.views));
   options.sampling.num_views = args.views;
   options.distance_m = args.distance;
-  const unsigned cores = std::thread::hardware_concurrency();
-  options.threads = args.threads > 0 ? args.threads : static_cast<int>(cores > 0 ? cores : 1);
+  if (args.threads < 0 || args.threads > kMaxThreads) {
+    ThrowInputError("threads", "", "0 (every core) or 1 to " + std::to_string(kMaxThreads),
+                    std::to_string(args.threads));
+  }
+  const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  options.threads = args.threads > 0 ? args.threads : std::min(cores, kMaxThreads);
   if (args.size.first < 1 || args.size.second < 1) {
     ThrowInputError("size", "", "(width, height) in pixels, each >= 1",
                     std::to_string(args.size.first) + "x" + std::to_string(args.size.second));

@@ -11,6 +11,7 @@
 #include "arrays.h"
 #include "bindings.h"
 #include "core/error.h"
+#include "core/parallel.h"
 #include "io/frame_io.h"
 #include "library.h"
 #include "recognize/recognition_stream.h"
@@ -108,14 +109,14 @@ void SetKeyword(const std::string& key, const py::handle& value, RecognizeArgume
     CheckRange(key.c_str(), x, low, high);
     return x;
   };
-  const auto count = [&](int low) {
+  const auto count = [&](int low, double high = 1e9) {
     const int n = Cast<int>(key, value, "a whole number");
-    CheckRange(key.c_str(), n, low, 1e9);
+    CheckRange(key.c_str(), n, low, high);
     return n;
   };
   const auto flag = [&] { return Cast<bool>(key, value, "True or False"); };
   if (key == "threads") {
-    args->threads = count(1);
+    args->threads = count(1, kMaxThreads);
   } else if (key == "seed") {
     args->seed = static_cast<uint64_t>(count(0));
   } else if (key == "track") {

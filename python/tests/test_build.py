@@ -53,6 +53,7 @@ def test_bad_build_arguments_are_named(tmp_path):
     db = str(tmp_path / "lib.sqlite")
     for name, kwargs in [("views", {"views": 0}), ("shading", {"shading": "flat"}), ("size", {"size": (0, 480)}),
                          ("camera", {"camera": [[1, 0], [0, 1]]}), ("name", {"name": "one"}),
+                         ("threads", {"threads": 10**6}), ("threads", {"threads": -1}),
                          ("object_from_mesh", {"object_from_mesh": [[2, 0, 0, 0]] + [[0, 0, 0, 1]] * 3})]:
         with pytest.raises(ecvpose.InputError) as error:
             ecvpose.build_models(db, DEMO_MESHES, **kwargs)

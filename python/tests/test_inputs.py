@@ -53,6 +53,13 @@ def test_a_bad_camera_matrix_is_named(recognizer, demo_frame):
     raises_naming("K", recognizer.recognize, color, depth, negative)
 
 
+def test_thread_counts_are_bounded(demo_library):
+    for threads in (0, 257, 10**6):
+        message = raises_naming("threads", ecvpose.Recognizer, demo_library, threads=threads)
+        assert "[1, 256]" in message, message
+    assert ecvpose.Recognizer(demo_library, threads=256) is not None
+
+
 def test_bad_options_files_and_names_are_named(demo_library, demo_library_path, tmp_path, demo_frame):
     raises_naming("threads", ecvpose.Recognizer, demo_library, threads=0)
     raises_naming("track_score", ecvpose.Recognizer, demo_library, track=True, track_score=1.5)

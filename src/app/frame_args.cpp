@@ -8,6 +8,7 @@
 #include <thread>
 #include <vector>
 
+#include "core/parallel.h"
 #include "io/mesh_io.h"
 #include "io/pose_io.h"
 
@@ -36,7 +37,7 @@ LoadedFrame LoadFrameWithWarnings(const FrameSpec& spec) {
 }
 
 int AllCores() {
-  return static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
+  return std::min(kMaxThreads, static_cast<int>(std::max(1U, std::thread::hardware_concurrency())));
 }
 
 namespace {
@@ -59,6 +60,15 @@ CLI::Validator NumberCheck(const std::string& what, const std::string& descripti
 CLI::Validator AtLeastOne() {
   return NumberCheck("a whole number of at least 1", "POSITIVE",
                      [](double v) { return v >= 1.0 && v == std::floor(v); });
+}
+
+CLI::Validator OneTo(int most) {
+  return NumberCheck("a whole number from 1 to " + std::to_string(most), "[1 - " + std::to_string(most) + "]",
+                     [most](double v) { return v >= 1.0 && v <= most && v == std::floor(v); });
+}
+
+CLI::Validator ThreadCount() {
+  return OneTo(kMaxThreads);
 }
 
 CLI::Validator Positive() {

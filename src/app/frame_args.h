@@ -17,14 +17,16 @@ void AddFrameFlags(CLI::App& command, FrameSpec* spec);
 /// a warning.
 LoadedFrame LoadFrameWithWarnings(const FrameSpec& spec);
 
-/// Default of the --threads flags: every core of the machine (at least 1).
+/// Default of the --threads flags: every core of the machine (at least 1, at most kMaxThreads).
 int AllCores();
 
 /// Checks of numeric flags whose messages say what was expected ("--views: expected a whole number of at least 1,
 /// got 0"), for counts, sizes and distances.
-CLI::Validator AtLeastOne();   ///< a whole number >= 1 (threads, views, pixels)
-CLI::Validator Positive();     ///< a number > 0
-CLI::Validator NonNegative();  ///< a number >= 0
+CLI::Validator AtLeastOne();     ///< a whole number >= 1 (views, pixels)
+CLI::Validator OneTo(int most);  ///< a whole number from 1 to `most` (threads, image sizes)
+CLI::Validator ThreadCount();    ///< OneTo(kMaxThreads), for every --threads
+CLI::Validator Positive();       ///< a number > 0
+CLI::Validator NonNegative();    ///< a number >= 0
 
 /// The mesh flags shared by every subcommand that reads meshes.
 struct MeshArgs {

@@ -102,7 +102,7 @@ CommandAction SetupRegisterCommand(CLI::App& command) {
   command.add_option("--seed", ransac.seed, "Random seed")->capture_default_str()->group("RANSAC");
   command.add_option("--threads", ransac.threads, "RANSAC threads (same result for any count)")
       ->capture_default_str()
-      ->check(AtLeastOne())
+      ->check(ThreadCount())
       ->group("RANSAC");
   command.add_flag("--no-icp", args->no_icp, "Skip the point-to-plane ICP refinement")->group("RANSAC");
   command.footer(

@@ -4,10 +4,19 @@
 #include <atomic>
 #include <exception>
 #include <mutex>
+#include <system_error>
 #include <thread>
 #include <vector>
 
+#include "core/error.h"
+
 namespace ecv {
+
+void CheckThreadCount(const std::string& source, int threads) {
+  if (threads < 1 || threads > kMaxThreads) {
+    ThrowInputError(source, "threads", "1 to " + std::to_string(kMaxThreads), std::to_string(threads));
+  }
+}
 
 void RunOnThreads(int threads, const std::function<void()>& work) {
   std::exception_ptr failure;
@@ -21,7 +30,14 @@ void RunOnThreads(int threads, const std::function<void()>& work) {
     }
   };
   std::vector<std::thread> workers;
-  for (int t = 1; t < threads; ++t) workers.emplace_back(guarded);
+  workers.reserve(static_cast<size_t>(std::max(threads - 1, 0)));  // before any thread runs: no joinable one is lost
+  for (int t = 1; t < threads; ++t) {
+    try {
+      workers.emplace_back(guarded);
+    } catch (const std::system_error&) {
+      break;  // out of threads: the work is shared out among those that run
+    }
+  }
   guarded();
   for (std::thread& worker : workers) worker.join();
   if (failure) std::rethrow_exception(failure);

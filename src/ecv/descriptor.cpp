@@ -360,7 +360,7 @@ Descriptors ComputeDescriptors(const std::vector<Primitive>& input, const Descri
     ThrowInputError("descriptor computation", "surface.normals", "one normal per point",
                     std::to_string(surface->normals.size()) + " for " + std::to_string(surface->points.size()));
   }
-  if (threads < 1) ThrowInputError("descriptor computation", "threads", "at least 1", std::to_string(threads));
+  CheckThreadCount("descriptor computation", threads);
   if (source_step < 1) {
     ThrowInputError("descriptor computation", "source_step", "at least 1", std::to_string(source_step));
   }

@@ -342,7 +342,7 @@ void RansacOptions::Check() const {
   require(success_probability > 0.0 && success_probability < 1.0, "success_probability", "in (0, 1)");
   require(expected_inlier_ratio > 0.0 && expected_inlier_ratio <= 1.0, "expected_inlier_ratio", "in (0, 1]");
   require(max_iterations >= 0, "max_iterations", ">= 0 (0: from p, w and n)");
-  require(threads >= 1, "threads", "at least 1");
+  CheckThreadCount("RANSAC options", threads);
   require(min_support >= 0, "min_support", ">= 0 (0: no test)");
   require(min_support_share >= 0.0 && min_support_share <= 1.0, "min_support_share", "in [0, 1] (0: no test)");
   require(projective_stride_px >= 0, "projective_stride_px", ">= 0 (0: the nearest scene point)");

@@ -36,7 +36,7 @@ struct RansacOptions {
   /// box from the same box turned over, which fit the scene's shape equally well.
   bool prefer_agreeing = false;
   uint64_t seed = 1;  ///< same seed, same result (whatever the number of threads)
-  int threads = 1;    ///< worker threads; the result does not depend on it
+  int threads = 1;    ///< worker threads (1 to kMaxThreads); the result does not depend on it
   /// Beyond the paper: object points are checked in a fixed random order and a hypothesis is dropped once
   /// its inlier count falls 3 standard deviations below the required fraction (binomial), after at least
   /// 50 points. Wrong poses are then dropped after a few hundred points instead of all of them; a pose

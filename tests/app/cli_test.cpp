@@ -94,11 +94,11 @@ TEST(Cli, BadInputExitsWithOneAndNamesTheFile) {
 TEST(Cli, NumericFlagsOutOfRangeSayWhatTheyExpect) {
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"modeldb build x.obj --db x.sqlite --views 0", "--views: expected a whole number of at least 1, got 0"},
-      {"modeldb build x.obj --db x.sqlite --threads 1.5", "--threads: expected a whole number of at least 1, got 1.5"},
+      {"modeldb build x.obj --db x.sqlite --threads 1.5", "--threads: expected a whole number from 1 to 256, got 1.5"},
       {"modeldb build x.obj --db x.sqlite --distance -1", "--distance: expected a number >= 0, got -1"},
-      {"recognize --db x.sqlite frame --threads 0", "--threads: expected a whole number of at least 1, got 0"},
-      {"register a b --threads many", "--threads: expected a whole number of at least 1, got many"},
-      {"render x.obj --views 3 --out d --height 0", "--height: expected a whole number of at least 1, got 0"},
+      {"recognize --db x.sqlite frame --threads 0", "--threads: expected a whole number from 1 to 256, got 0"},
+      {"register a b --threads many", "--threads: expected a whole number from 1 to 256, got many"},
+      {"render x.obj --views 3 --out d --height 0", "--height: expected a whole number from 1 to 8192, got 0"},
       {"colorcal auto --db x.sqlite --model m frame --max-depth-difference 0",
        "--max-depth-difference: expected a number > 0, got 0"},
   };
@@ -106,6 +106,16 @@ TEST(Cli, NumericFlagsOutOfRangeSayWhatTheyExpect) {
     const test::CommandResult result = test::RunCli(arguments);
     EXPECT_EQ(result.exit_code, 2) << arguments << "\n" << result.output;
     EXPECT_THAT(result.output, HasSubstr(message)) << arguments;
+  }
+}
+
+// A thread count the system cannot start is a usage error naming the flag and its range, not an abort.
+TEST(Cli, ThreadCountsAreBounded) {
+  for (const std::string command :
+       {"modeldb build x.obj --db x.sqlite", "recognize --db x.sqlite frame", "register a b", "serve --db x.sqlite"}) {
+    const test::CommandResult result = test::RunCli(command + " --threads 1000000");
+    EXPECT_EQ(result.exit_code, 2) << command << "\n" << result.output;
+    EXPECT_THAT(result.output, HasSubstr("--threads: expected a whole number from 1 to 256, got 1000000")) << command;
   }
 }
 

@@ -260,6 +260,34 @@ TEST(ModelDatabase, VerifyFindsChangedDescriptorsAndOrphans) {
   EXPECT_THAT(report.problems, Contains(HasSubstr("2 views stored, 1 present")));
 }
 
+// Stored values a load needs are checked one by one: a view pose that is not a rigid transform, a diameter that is
+// not finite, a view camera without a size, each named by model, view and field.
+TEST(ModelDatabase, VerifyFindsStoredValuesThatAreNotPosesOrSizes) {
+  test::TemporaryDirectory directory;
+  const std::string path = directory.File("lib.sqlite");
+  {
+    ModelDatabase database(path, OpenMode::kCreate);
+    database.AddModel(test::SyntheticModel("a", 3, 20, 1));
+    EXPECT_TRUE(database.Verify().ok());
+  }
+  {
+    SqlConnection raw(path, SqlOpenMode::kReadWrite, 1000);
+    raw.Execute("UPDATE views SET camera_from_object = 'garbage' WHERE view_index = 0");
+    raw.Execute(
+        "UPDATE views SET camera_from_object = '[[2,0,0,0],[0,1,0,0],[0,0,1,0.5],[0,0,0,1]]' WHERE view_index = 1");
+    raw.Execute("UPDATE views SET width = 0 WHERE view_index = 2");
+    raw.Execute("UPDATE models SET diameter_m = 1e999");  // SQLite's infinity
+  }
+  const VerifyReport report = ModelDatabase(path, OpenMode::kReadOnly).Verify(false);
+  EXPECT_THAT(report.problems,
+              Contains(AllOf(HasSubstr("model a view 0: camera_from_object"), HasSubstr("got garbage"))));
+  EXPECT_THAT(report.problems,
+              Contains(AllOf(HasSubstr("model a view 1: camera_from_object"), HasSubstr("a rotation"))));
+  EXPECT_THAT(report.problems, Contains(HasSubstr("model a view 2: camera: width/height")));
+  EXPECT_THAT(report.problems, Contains("model a: diameter_m: expected a finite size > 0 m, got inf"));
+  EXPECT_EQ(report.problems.size(), 4U) << ::testing::PrintToString(report.problems);
+}
+
 // The mesh bytes go in and out as they are, with the model's transaction: replaced with it, removed with it, and
 // checked against their digest by verify.
 TEST(ModelDatabase, StoresAModelsMeshWithItAndVerifiesItsDigest) {

@@ -102,6 +102,60 @@ TEST_F(ServeProtocol, ABadRequestGetsAnErrorLineAndTheNextOneIsAnswered) {
   EXPECT_TRUE(answer.at("id").is_null());
 }
 
+// Lines a hostile client may send: each is answered with an error line that is valid UTF-8, and the next is answered.
+TEST_F(ServeProtocol, InvalidUtf8AndDeepNestingGetErrorLines) {
+  RecognitionService service(*recognizer_, StreamOptions{});
+  const auto error_of = [&](const std::string& line) {
+    const std::string answer = service.Answer(line);
+    nlohmann::json response;
+    EXPECT_NO_THROW(response = nlohmann::json::parse(answer)) << answer;  // the parser refuses invalid UTF-8
+    EXPECT_FALSE(response.contains("detections")) << answer;
+    return response.value("error", std::string());
+  };
+  EXPECT_NE(error_of("{\"id\": 14, \"frame\": \"\xff\xfe\"}").find("one JSON object per line"), std::string::npos);
+  EXPECT_NE(error_of("{\"id\": 15, \"frame\": \"a\xc3\"}").find("one JSON object per line"), std::string::npos);
+  const std::string deep = "request: JSON: expected [ and { nested at most 64 deep";
+  EXPECT_NE(error_of(std::string(100000, '[') + std::string(100000, ']')).find(deep), std::string::npos);
+  EXPECT_NE(error_of(std::string(100000, '[')).find(deep), std::string::npos);
+  EXPECT_NE(error_of(R"({"id": )" + std::string(64, '{') + "}").find(deep), std::string::npos);
+  // Brackets inside strings, escaped quotes included, are text: the request is judged on its frame.
+  const std::string text = R"(\"[)" + std::string(100, '[') + std::string(100, '{');
+  EXPECT_NE(error_of(R"({"id": ")" + text + R"(", "frame": "/no/such/000001"})").find("/no/such/000001"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"id": )" + std::string(63, '[') + std::string(63, ']') + R"(, "frame": "/no/such/000001"})")
+                .find("/no/such/000001"),
+            std::string::npos);
+
+  RecognitionService small(*recognizer_, StreamOptions{}, RequestLimits{100, 64});
+  EXPECT_EQ(nlohmann::json::parse(small.Answer(std::string(101, ' '))).at("error"),
+            "request: JSON: expected a line of at most 100 bytes");
+  EXPECT_EQ(small.AnswerTooLong(), small.Answer(std::string(101, ' ')));
+}
+
+// The same through the command: a line of invalid UTF-8, a deep one and one past --max-request-bytes each get an
+// error line and the service answers the request after them.
+TEST_F(ServeProtocol, TheServiceGoesOnAfterHostileLines) {
+  const std::string requests = directory_->File("hostile.jsonl"), served = directory_->File("hostile_served.jsonl");
+  {
+    std::ofstream out(requests, std::ios::binary);
+    out << "{\"id\": 14, \"frame\": \"\xff\xfe\"}\n";
+    out << std::string(100000, '[') << std::string(100000, ']') << '\n';  // 200 KB
+    out << R"({"id": 16, "frame": ")" << std::string(300000, 'x') << "\"}\n";
+    out << R"({"id": 17, "frame": "/no/such/000001"})" << '\n';
+  }
+  const test::CommandResult serve =
+      test::RunCommand(std::string("(") + ECV_CLI_PATH + " serve --db " + library_ + " --max-request-bytes 250000 < " +
+                       requests + " > " + served + ")");
+  ASSERT_EQ(serve.exit_code, 0) << serve.output;
+  const std::vector<nlohmann::json> answers = ReadLines(served);
+  ASSERT_EQ(answers.size(), 4U);
+  EXPECT_NE(answers[0].at("error").get<std::string>().find("one JSON object per line"), std::string::npos);
+  EXPECT_NE(answers[1].at("error").get<std::string>().find("nested at most 64 deep"), std::string::npos);
+  EXPECT_EQ(answers[2].at("error"), "request: JSON: expected a line of at most 250000 bytes");
+  EXPECT_EQ(answers[3].at("id"), 17);
+  EXPECT_NE(answers[3].at("error").get<std::string>().find("/no/such/000001"), std::string::npos);
+}
+
 TEST_F(ServeProtocol, TrackedRequestsFollowTheirObjectsUntilAResetOrAnUntrackedOne) {
   RecognitionService service(*recognizer_, StreamOptions{});
   const std::string frame = "\"frame\": \"" + DemoFrame() + "\"";

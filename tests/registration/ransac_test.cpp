@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "core/error.h"
+#include "core/parallel.h"
 #include "core/pose.h"
 #include "registration/ransac.h"
 
@@ -221,6 +222,19 @@ TEST(Ransac, ASharedSceneGridGivesTheSameResultAndAWrongOneIsRefused) {
     } catch (const InputError& error) {
       EXPECT_NE(std::string(error.what()).find("scene_grid"), std::string::npos) << error.what();
     }
+  }
+}
+
+TEST(Ransac, ThreadCountsBeyondTheBoundAreRefusedByName) {
+  RansacOptions options;
+  options.threads = kMaxThreads;
+  EXPECT_NO_THROW(options.Check());
+  options.threads = 1000000;
+  try {
+    options.Check();
+    ADD_FAILURE() << "a million threads were accepted";
+  } catch (const InputError& error) {
+    EXPECT_STREQ(error.what(), "RANSAC options: threads: expected 1 to 256, got 1000000");
   }
 }
 

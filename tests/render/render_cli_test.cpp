@@ -168,5 +168,15 @@ TEST(RenderCli, BadInputsAndContextFailureAreClearErrors) {
   EXPECT_FALSE(std::filesystem::exists(out.File("v/views.json"))) << "nothing written after a failure";
 }
 
+// The stated largest image renders (render_test); beyond it is a usage error before the mesh is read.
+TEST(RenderCli, ImageSizesBeyondWhatRendersAreUsageErrors) {
+  test::TemporaryDirectory out;
+  const test::CommandResult huge = test::RunCli(
+      "render " + test::DataPath(kCan) + " --unit mm --views 1 --width 16384 --height 16384 --out " + out.File("v"));
+  EXPECT_EQ(huge.exit_code, 2) << huge.output;
+  EXPECT_THAT(huge.output, HasSubstr("--width: expected a whole number from 1 to 8192, got 16384"));
+  EXPECT_FALSE(std::filesystem::exists(out.File("v")));
+}
+
 }  // namespace
 }  // namespace ecv

@@ -248,6 +248,31 @@ TEST(RenderTest, MeshWithoutTrianglesIsAnInputError) {
   EXPECT_THROW(renderer.AddMesh(mesh), InputError);
 }
 
+// An image side past kMaxRenderSide is refused by name before anything is allocated; kMaxRenderSide itself renders.
+TEST(RenderTest, ImageSidesBeyondTheBoundAreAnInputError) {
+  TriangleMesh mesh;
+  mesh.name = "triangle";
+  mesh.parts.resize(1);
+  mesh.parts[0].positions = {{0, 0, 0}, {0.1F, 0, 0}, {0, 0.1F, 0}};
+  mesh.parts[0].triangles = {{0, 1, 2}};
+  Renderer renderer;
+  const MeshId triangle = renderer.AddMesh(mesh);
+  Eigen::Isometry3d camera_from_object = Eigen::Isometry3d::Identity();
+  camera_from_object.translation() = Eigen::Vector3d(0.0, 0.0, 0.5);
+  const PinholeCamera wide{500.0, 500.0, 10.0, 0.0, kMaxRenderSide, 1};
+  EXPECT_EQ(renderer.Render(triangle, wide, camera_from_object).depth.cols, kMaxRenderSide);
+  for (const PinholeCamera& camera : {PinholeCamera{500.0, 500.0, 10.0, 0.0, kMaxRenderSide + 1, 1},
+                                      PinholeCamera{500.0, 500.0, 0.0, 10.0, 1, 16384}}) {
+    try {
+      renderer.Render(triangle, camera, camera_from_object);
+      ADD_FAILURE() << camera.width << "x" << camera.height << " was rendered";
+    } catch (const InputError& error) {
+      EXPECT_EQ(std::string(error.what()), "render camera: width/height: expected at most 8192 pixels, got " +
+                                               std::to_string(camera.width) + "x" + std::to_string(camera.height));
+    }
+  }
+}
+
 TEST(RenderTest, CullingBackFacesOfAClosedMeshKeepsTheImage) {
   const YcbFrame ycb = LoadFrame0001();
   const TriangleMesh mesh = LoadCrackerBox();
