@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "io/read_roots.h"
 #include "recognize/recognition_stream.h"
 #include "recognize/recognizer.h"
 
@@ -26,12 +27,15 @@ struct RequestLimits {
 /// "depth_scale": S, "camera": [fx, fy, cx, cy]}`, with optional `"id"` (any JSON value, echoed), `"track"` (follow
 /// the objects of the previous tracked request; default: the service's) and `"reset": true` (forget the tracks
 /// first). The response is the detections as `recognize --out-json` writes them, with `"id"` and `"frame"`, or
-/// `{"id": ..., "error": MESSAGE}` for a request that is malformed, past `limits` or whose frame cannot be read.
+/// `{"id": ..., "error": MESSAGE}` for a request that is malformed, past `limits` or whose frame cannot be read. Every
+/// file a frame names is checked against `roots` before anything reads it; a refused one gets the one message
+/// "frame: not readable here: PATH", PATH as the request gives it, whatever the reason.
 class RecognitionService {
  public:
   /// `recognizer` must outlive the service. `stream`: whether requests track by default, and the search schedule
-  /// of tracked requests.
-  RecognitionService(Recognizer& recognizer, const StreamOptions& stream, const RequestLimits& limits = {});
+  /// of tracked requests. `roots`: where frames may be read (default: anywhere, FIFOs, devices and folders aside).
+  RecognitionService(Recognizer& recognizer, const StreamOptions& stream, const RequestLimits& limits = {},
+                     ReadRoots roots = {});
 
   /// The response to one request line.
   nlohmann::json Handle(const std::string& line);
@@ -54,6 +58,7 @@ class RecognitionService {
   Recognizer& recognizer_;
   bool track_by_default_;
   RequestLimits limits_;
+  ReadRoots roots_;
   RecognitionStream stream_;  // of the tracked requests
 };
 

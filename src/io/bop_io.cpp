@@ -10,6 +10,7 @@
 #include "io/files.h"
 #include "io/frame_io.h"
 #include "io/pose_io.h"
+#include "io/read_roots.h"
 
 namespace ecv {
 namespace fs = std::filesystem;
@@ -19,6 +20,17 @@ std::string ImageFile(const std::string& scene_dir, const char* folder, int imag
   char name[32];
   std::snprintf(name, sizeof(name), "%06d%s", image_id, extension);
   return (fs::path(scene_dir) / folder / name).string();
+}
+
+// The colour image of `image_id`: the first of rgb/ (PNG, JPG) and gray/ (PNG, TIFF) that exists; rgb/*.png, to be
+// named in the error, when none does.
+std::string ColorImageFile(const std::string& scene_dir, int image_id) {
+  for (const auto& [folder, extension] :
+       {std::pair{"rgb", ".png"}, std::pair{"rgb", ".jpg"}, std::pair{"gray", ".png"}, std::pair{"gray", ".tif"}}) {
+    std::string path = ImageFile(scene_dir, folder, image_id, extension);
+    if (PathExists(path)) return path;
+  }
+  return ImageFile(scene_dir, "rgb", image_id, ".png");
 }
 
 const nlohmann::json& ImageEntry(const nlohmann::json& json, const std::string& path, int image_id) {
@@ -108,12 +120,7 @@ LoadedFrame LoadBopFrame(const std::string& scene_dir, int image_id, const std::
   const std::vector<double> k = Numbers(camera, "cam_K", 9, camera_path);
   const double depth_scale_mm = OptionalNumber(camera, "depth_scale", 1.0, camera_path);  // mm = value * depth_scale
 
-  std::string color_path = ImageFile(scene_dir, "rgb", image_id, ".png");
-  for (const auto& [folder, extension] :
-       {std::pair{"rgb", ".jpg"}, std::pair{"gray", ".png"}, std::pair{"gray", ".tif"}}) {
-    if (!PathExists(color_path)) color_path = ImageFile(scene_dir, folder, image_id, extension);
-  }
-  if (!PathExists(color_path)) color_path = ImageFile(scene_dir, "rgb", image_id, ".png");  // name it in the error
+  const std::string color_path = ColorImageFile(scene_dir, image_id);
   const std::string depth_path =
       depth_override.empty() ? ImageFile(scene_dir, "depth", image_id, ".png") : depth_override;
 
@@ -126,6 +133,17 @@ LoadedFrame LoadBopFrame(const std::string& scene_dir, int image_id, const std::
   loaded.scene_id = std::max(0, NumberOfName(folder.filename().string()));
   loaded.image_id = image_id;
   return loaded;
+}
+
+std::vector<std::string> BopFrameFiles(const std::string& scene_dir, int image_id, const std::string& depth_override) {
+  const fs::path scene(scene_dir);
+  std::vector<std::string> files = {
+      (scene / "scene_camera.json").string(), ColorImageFile(scene_dir, image_id),
+      depth_override.empty() ? ImageFile(scene_dir, "depth", image_id, ".png") : depth_override};
+  for (const char* name : {"scene_gt.json", "scene_gt_info.json"}) {
+    if (PathExists(scene / name)) files.push_back((scene / name).string());
+  }
+  return files;
 }
 
 }  // namespace ecv

@@ -12,7 +12,9 @@
 
 #include "core/error.h"
 #include "io/files.h"
+#include "io/image_bytes.h"
 #include "io/pose_io.h"
+#include "io/read_roots.h"
 
 namespace ecv {
 namespace fs = std::filesystem;
@@ -25,12 +27,6 @@ constexpr const char* kFrameForms =
 void RequireFile(const std::string& path, const std::string& what) {
   if (!PathExists(path)) ThrowInputError(path, what, "an existing file", "no such file");
   if (IsDirectory(path)) ThrowInputError(path, what, "a file", "a directory");
-}
-
-std::string ImageTypeText(const cv::Mat& image) {
-  const int depth = image.depth();
-  const char* bits = depth == CV_8U ? "8-bit" : depth == CV_16U ? "16-bit" : depth == CV_32F ? "32-bit float" : "other";
-  return std::string(bits) + " " + std::to_string(image.channels()) + "-channel";
 }
 
 bool EndsWith(const std::string& text, const std::string& suffix) {
@@ -52,11 +48,23 @@ bool HasFlagForm(const FrameSpec& spec) {
   return !spec.color_path.empty() || !spec.depth_path.empty() || spec.depth_scale || spec.camera;
 }
 
+// The forms of a positional FRAME, told apart in this order.
+enum class PositionalForm { kBopImage, kJson, kPcd, kYcbvPrefix, kNone };
+
+PositionalForm FormOf(const std::string& path, std::string* scene_dir, int* image_id) {
+  if (SplitBopImage(path, scene_dir, image_id)) return PositionalForm::kBopImage;
+  if (EndsWith(path, ".json")) return PositionalForm::kJson;
+  if (EndsWith(path, ".pcd")) return PositionalForm::kPcd;
+  if (PathExists(path + "-color.png")) return PositionalForm::kYcbvPrefix;
+  return PositionalForm::kNone;
+}
+
 LoadedFrame LoadPositional(const FrameSpec& spec) {
   const std::string& path = spec.positional;
   std::string scene_dir;
   int image_id = 0;
-  if (SplitBopImage(path, &scene_dir, &image_id)) {
+  const PositionalForm form = FormOf(path, &scene_dir, &image_id);
+  if (form == PositionalForm::kBopImage) {
     if (!spec.color_path.empty() || spec.camera) {
       ThrowInputError(path, "--color/--camera", "no --color or --camera with a BOP image (only --depth)");
     }
@@ -71,11 +79,17 @@ LoadedFrame LoadPositional(const FrameSpec& spec) {
   if (HasFlagForm(spec)) {
     ThrowInputError(path, "FRAME", "either a positional FRAME or --color/--depth/--depth-scale/--camera, not both");
   }
-  if (EndsWith(path, ".json")) return LoadFrameJson(path);
-  if (EndsWith(path, ".pcd")) return LoadPcdFrame(path);
-  if (PathExists(path + "-color.png")) return LoadYcbvFrame(path);
+  if (form == PositionalForm::kJson) return LoadFrameJson(path);
+  if (form == PositionalForm::kPcd) return LoadPcdFrame(path);
+  if (form == PositionalForm::kYcbvPrefix) return LoadYcbvFrame(path);
   if (PathExists(path)) ThrowInputError(path, "FRAME", kFrameForms, "a file of none of these forms");
   ThrowInputError(path, "FRAME", kFrameForms, "no such file, YCB-Video prefix or BOP scene directory");
+}
+
+// The colour and depth files of a frame JSON, relative to it; empty for a key that is not a string.
+std::string FrameJsonFile(const nlohmann::json& json, const std::string& path, const char* key) {
+  if (!json.is_object() || !json.contains(key) || !json[key].is_string()) return "";
+  return (fs::path(path).parent_path() / json[key].get<std::string>()).string();
 }
 
 // Image ids of a BOP scene whose colour (rgb/ PNG or JPG, or gray/) and depth/ PNG exist, in increasing order.
@@ -155,6 +169,35 @@ std::vector<std::string> ListFileFrames(const std::string& path) {
 
 }  // namespace
 
+void CheckFrameFiles(const FrameSpec& spec, const std::function<void(const std::string&)>& check) {
+  std::vector<std::string> files = {spec.color_path, spec.depth_path};
+  const std::string& path = spec.positional;
+  std::string scene_dir;
+  int image_id = 0;
+  switch (path.empty() ? PositionalForm::kNone : FormOf(path, &scene_dir, &image_id)) {
+    case PositionalForm::kBopImage: {
+      const std::vector<std::string> bop = BopFrameFiles(scene_dir, image_id, spec.depth_path);
+      files.insert(files.end(), bop.begin(), bop.end());
+      break;
+    }
+    case PositionalForm::kJson: {
+      check(path);  // before it is parsed
+      const nlohmann::json json = ReadJsonFile(path);
+      files.push_back(FrameJsonFile(json, path, "color"));
+      files.push_back(FrameJsonFile(json, path, "depth"));
+      break;
+    }
+    case PositionalForm::kYcbvPrefix:
+      for (const char* suffix : {"-meta.mat", "-color.png", "-depth.png"}) files.push_back(path + suffix);
+      break;
+    case PositionalForm::kPcd:
+    case PositionalForm::kNone: files.push_back(path); break;
+  }
+  for (const std::string& file : files) {
+    if (!file.empty()) check(file);
+  }
+}
+
 std::vector<std::string> ListSequenceFrames(const std::string& dir_or_list) {
   if (!PathExists(dir_or_list)) {
     ThrowInputError(dir_or_list, "sequence", "a directory of frames or a text file with one FRAME per line",
@@ -215,15 +258,7 @@ cv::Mat ReadColorImage(const std::string& path) {
   RequireFile(path, "colour image");
   const cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
   if (image.empty()) ThrowInputError(path, "colour image", "a PNG or JPG image", "an unreadable file");
-  if (image.depth() != CV_8U || (image.channels() != 3 && image.channels() != 4 && image.channels() != 1)) {
-    ThrowInputError(path, "colour image", "an 8-bit grey, RGB or RGBA image", ImageTypeText(image));
-  }
-  cv::Mat rgb;
-  const int code = image.channels() == 1   ? cv::COLOR_GRAY2RGB
-                   : image.channels() == 4 ? cv::COLOR_BGRA2RGB
-                                           : cv::COLOR_BGR2RGB;
-  cv::cvtColor(image, rgb, code);
-  return rgb;
+  return ColorImageAsRgb(image, path);
 }
 
 void WriteColorImage(const std::string& path, const cv::Mat& image) {
@@ -244,19 +279,11 @@ void WriteColorImage(const std::string& path, const cv::Mat& image) {
 }
 
 cv::Mat ReadDepthImage(const std::string& path, double depth_scale) {
-  if (!std::isfinite(depth_scale) || depth_scale <= 0.0) {
-    ThrowInputError(path, "depth_scale", "a finite positive scale (metres = value / scale)",
-                    std::to_string(depth_scale));
-  }
+  CheckDepthScale(depth_scale, path);
   RequireFile(path, "depth image");
   const cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
   if (image.empty()) ThrowInputError(path, "depth image", "a 16-bit single-channel PNG", "an unreadable file");
-  if (image.type() != CV_16UC1) {
-    ThrowInputError(path, "depth image", "a 16-bit single-channel PNG", ImageTypeText(image));
-  }
-  cv::Mat metres;
-  image.convertTo(metres, CV_32F, 1.0 / depth_scale);
-  return metres;
+  return DepthImageAsMetres(image, depth_scale, path);
 }
 
 std::array<double, 4> ParseIntrinsics(const std::string& text, const std::string& source) {
@@ -282,19 +309,9 @@ std::array<double, 4> ParseIntrinsics(const std::string& text, const std::string
 
 RgbdFrame MakeFrame(const std::string& color_path, const std::string& depth_path, double depth_scale,
                     const std::array<double, 4>& intrinsics, const std::string& source) {
-  RgbdFrame frame;
-  frame.name = source;
-  frame.color = ReadColorImage(color_path);
-  frame.depth = ReadDepthImage(depth_path, depth_scale);
-  if (frame.color.size() != frame.depth.size()) {
-    ThrowInputError(depth_path, "depth image size",
-                    std::to_string(frame.color.cols) + "x" + std::to_string(frame.color.rows) +
-                        " as the colour image " + color_path,
-                    std::to_string(frame.depth.cols) + "x" + std::to_string(frame.depth.rows));
-  }
-  frame.camera = {intrinsics[0], intrinsics[1], intrinsics[2], intrinsics[3], frame.color.cols, frame.color.rows};
-  frame.Check();
-  return frame;
+  const cv::Mat color = ReadColorImage(color_path);  // first: its errors are said first
+  const cv::Mat depth = ReadDepthImage(depth_path, depth_scale);
+  return FrameOfImages(color, depth, intrinsics, color_path, depth_path, source);
 }
 
 int NumberOfName(const std::string& name) {
@@ -304,11 +321,10 @@ int NumberOfName(const std::string& name) {
 
 LoadedFrame LoadFrameJson(const std::string& path) {
   const nlohmann::json json = ReadJsonFile(path);
-  const fs::path base = fs::path(path).parent_path();
   auto string_field = [&](const char* key) {
-    if (!json.contains(key) || !json[key].is_string())
-      ThrowInputError(path, key, "a string (a path relative to the JSON)");
-    return (base / json[key].get<std::string>()).string();
+    std::string file = FrameJsonFile(json, path, key);
+    if (file.empty()) ThrowInputError(path, key, "a string (a path relative to the JSON)");
+    return file;
   };
   if (!json.contains("depth_scale") || !json["depth_scale"].is_number()) {
     ThrowInputError(path, "depth_scale", "a number S (metres = depth value / S)");
