@@ -13,8 +13,9 @@ from conftest import DEMO_FRAME
 
 
 def start(library_path, *flags):
+    # The service reads frames only below its roots: the demo frame's folder.
     process = subprocess.Popen([os.environ["ECVPOSE_CLI"], "serve", "--db", str(library_path), "--threads", "2",
-                                *flags], stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                "--root", os.path.dirname(DEMO_FRAME), *flags], stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                text=True)
     for line in process.stderr:  # the library and meshes are loaded before "ready"
         if "ready" in line:
