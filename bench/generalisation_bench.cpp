@@ -73,16 +73,26 @@ Run RunRecognizer(const ModelLibrary& library, const RecognizerOptions& options,
     run.detections.push_back(result.detections);
     run.ms.push_back(result.timings_ms.at("total"));
     run.frame_index.push_back(static_cast<int>(i));
-    const Counts counts = [&] {
-      Counts c;
-      c.Add(run.evaluations.back());
-      return c;
-    }();
+    Counts counts;
+    counts.Add(run.evaluations.back());
     std::cerr << label << " [" << i + 1 << "/" << frames.size() << "] " << frames[i].name << ": " << counts.correct
               << " of " << counts.present << ", " << counts.false_positives << " false, " << Fixed(run.ms.back(), 0)
               << " ms\n";
   }
   return run;
+}
+
+// A markdown table's heading: `first` columns, then one per run.
+std::string RunColumnsHeading(const std::vector<std::string>& first, const std::string& first_align,
+                              const std::vector<Run>& runs) {
+  std::ostringstream out;
+  out << '|';
+  for (const std::string& column : first) out << ' ' << column << " |";
+  for (const Run& run : runs) out << ' ' << run.label << " |";
+  out << "\n|" << first_align;
+  for (size_t i = 0; i < runs.size(); ++i) out << "---|";
+  out << '\n';
+  return out.str();
 }
 
 // Found / present, recall and false positives per frame, per set and condition (and per video of the casts).
@@ -106,11 +116,7 @@ std::string ConditionTable(const std::vector<Run>& runs, const std::vector<Bench
     return std::make_pair(rank(a), a) < std::make_pair(rank(b), b);
   });
   std::ostringstream out;
-  out << "| set: condition | frames |";
-  for (const Run& run : runs) out << ' ' << run.label << " |";
-  out << "\n|---|---:|";
-  for (size_t i = 0; i < runs.size(); ++i) out << "---|";
-  out << '\n';
+  out << RunColumnsHeading({"set: condition", "frames"}, "---|---:|", runs);
   for (const std::string& row : rows) {
     int frame_count = 0;
     for (const auto& [label, counts] : cells[row]) frame_count = std::max(frame_count, counts.frames);
@@ -143,11 +149,7 @@ std::string ObjectTable(const std::vector<Run>& runs, const std::vector<BenchFra
     }
   }
   std::ostringstream out;
-  out << "| object |";
-  for (const Run& run : runs) out << ' ' << run.label << " |";
-  out << "\n|---|";
-  for (size_t i = 0; i < runs.size(); ++i) out << "---|";
-  out << '\n';
+  out << RunColumnsHeading({"object"}, "---|", runs);
   for (const auto& [object, per_run] : cells) {
     out << "| " << object << " |";
     for (const Run& run : runs) {

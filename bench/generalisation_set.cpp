@@ -132,9 +132,8 @@ std::vector<BenchFrame> CompositeFrames(const std::vector<SourceFrame>& sources,
     const auto pick = [&](size_t n) { return std::uniform_int_distribution<size_t>(0, n - 1)(random); };
     Composite composite;
     bool made = false;
-    bool look_alike = false;
+    const bool look_alike = i % 2 == 0;
     for (int attempt = 0; attempt < 100 && !made; ++attempt) {
-      look_alike = i % 2 == 0;
       std::string object, beside;
       const SourceFrame* source = nullptr;
       const SourceFrame* target = nullptr;

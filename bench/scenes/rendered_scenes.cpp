@@ -26,17 +26,11 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kRadiansPerDegree = kPi / 180.0;
 constexpr int kMaxTextureSide = 2048;  // google16k textures (4096) are capped to this in LoadSceneAssets
 
-// YCB-Video's cls_index by name (its dataset's 21 objects), 0 for other names.
+// YCB-Video's cls_index by name (YcbvClassName's inverse over its 21 objects), 0 for other names.
 int YcbvClassIndex(const std::string& name) {
-  // clang-format off
-  static const std::array<const char*, 21> kNames = {
-      "002_master_chef_can", "003_cracker_box", "004_sugar_box", "005_tomato_soup_can", "006_mustard_bottle",
-      "007_tuna_fish_can", "008_pudding_box", "009_gelatin_box", "010_potted_meat_can", "011_banana",
-      "019_pitcher_base", "021_bleach_cleanser", "024_bowl", "025_mug", "035_power_drill", "036_wood_block",
-      "037_scissors", "040_large_marker", "051_large_clamp", "052_extra_large_clamp", "061_foam_brick"};
-  // clang-format on
-  for (size_t i = 0; i < kNames.size(); ++i) {
-    if (name == kNames[i]) return static_cast<int>(i) + 1;
+  constexpr int kClasses = 21;
+  for (int index = 1; index <= kClasses; ++index) {
+    if (name == YcbvClassName(index)) return index;
   }
   return 0;
 }
