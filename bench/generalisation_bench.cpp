@@ -9,13 +9,16 @@
 //   scripts/build_ycbv_library --with-untextured /tmp/ycbv16.sqlite --views 40 --distance 0.9
 //   generalisation_bench --db /tmp/ycbv.sqlite [--hypotheses context both] [--seeds 1 2 3] [--track]
 //                        [--rendered 200] [--composites 100] [--cast-step 1] [--split reporting|choosing] [--threads 2]
-//                        [--figures bench/figures] [--results bench/RESULTS.md]
+//                        [--figures bench/figures] [--results bench/RESULTS.md] [the settings flags of `recognize`]
+// Every setting of the recognizer's table (recognize/recognizer_settings.h) is a flag, as in `ecvpose recognize`, and
+// applies to every run; --hypotheses and --seeds take several values, one run each, and --track adds tracking runs.
 
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <map>
 #include <set>
@@ -25,11 +28,13 @@
 #include <opencv2/imgproc.hpp>
 
 #include "bench_util.h"
+#include "core/error.h"
 #include "generalisation_set.h"
 #include "modeldb/model_library.h"
 #include "recognize/evaluation.h"
 #include "recognize/recognition_stream.h"
 #include "recognize/recognizer.h"
+#include "recognize/settings_flags.h"
 
 namespace ecv::bench {
 namespace {
@@ -60,10 +65,13 @@ struct Counts {
   }
 };
 
-Run RunRecognizer(const ModelLibrary& library, const RecognizerOptions& options, const std::vector<BenchFrame>& frames,
-                  const std::vector<EvalModel>& models, const std::string& label, bool track) {
+// With `stream_options.track`: along the streams only, each a stream of its own.
+Run RunRecognizer(const ModelLibrary& library, const RecognizerOptions& options, const StreamOptions& stream_options,
+                  const std::vector<BenchFrame>& frames, const std::vector<EvalModel>& models,
+                  const std::string& label) {
+  const bool track = stream_options.track;
   Recognizer recognizer(library, options);
-  RecognitionStream stream(recognizer, {track, 1});
+  RecognitionStream stream(recognizer, stream_options);
   Run run{label, {}, {}, {}, {}};
   for (size_t i = 0; i < frames.size(); ++i) {
     if (track && frames[i].stream.empty()) continue;  // tracking runs over the streams only
@@ -283,31 +291,64 @@ void WriteFigures(const ModelLibrary& library, const Run& run, const std::vector
 struct Settings {
   std::string db, data = ECV_DATA_DIR, results = std::string(ECV_SOURCE_DIR) + "/bench/RESULTS.md",
                   figures = std::string(ECV_SOURCE_DIR) + "/bench/figures", split = "reporting", figure_format = "jpg";
-  std::vector<std::string> hypotheses = {"context"};
-  std::vector<uint64_t> seeds = {1};
-  int rendered = 200, composites = 100, threads = 2, cast_step = 1;
+  std::vector<std::string> hypotheses;  // empty: the table's default
+  std::vector<uint64_t> seeds;          // empty: --seed
+  int rendered = 200, composites = 100, cast_step = 1;
   bool track = false;
+  RecognizerSettings recognizer;  // every run: the settings table's flags
+  std::string detections;         // JSON Lines of every run's detections, when given
 };
+
+// One line per frame of `run`: its set, condition and name, the detections with their verification terms, and
+// which objects were found and which detections were false.
+void AppendDetections(const std::string& path, const Run& run, const std::vector<BenchFrame>& frames) {
+  std::ofstream out(path, std::ios::app);
+  if (!out) ThrowInputError(path, "--detections", "a file that can be written");
+  for (size_t k = 0; k < run.evaluations.size(); ++k) {
+    const BenchFrame& frame = frames[static_cast<size_t>(run.frame_index[k])];
+    RecognitionResult result;
+    result.detections = run.detections[k];
+    nlohmann::json found = nlohmann::json::object();
+    for (const ObjectEvaluation& object : run.evaluations[k].objects) found[object.model] = object.correct;
+    out << nlohmann::json{{"run", run.label},
+                          {"set", frame.set},
+                          {"condition", frame.condition},
+                          {"frame", frame.name},
+                          {"found", found},
+                          {"false_positives", run.evaluations[k].false_positive_models},
+                          {"detections", RecognitionToJson(result)["detections"]}}
+               .dump()
+        << '\n';
+  }
+}
 
 int Main(int argc, char** argv) {
   CLI::App app("Recognition on the generalisation set: rendered scenes, composites of real frames, cast light");
   Settings s;
   app.add_option("--db", s.db, "Model library (scripts/build_ycbv_library)")->required()->check(CLI::ExistingFile);
   app.add_option("--data", s.data, "The shared data folder (ycbv_subset, lmo_subset)");
-  app.add_option("--hypotheses", s.hypotheses, "Sources of pose hypotheses, one run each (context, ppf, both)");
-  app.add_option("--seeds", s.seeds, "RANSAC seeds, one run each");
+  AddSettingValues(app, "hypotheses", &s.hypotheses, "Sources of pose hypotheses, one run each (context, ppf, both)");
+  app.add_option("--seeds", s.seeds, "RANSAC seeds, one run each (default: --seed)");
   app.add_option("--rendered", s.rendered, "Rendered scenes")->check(CLI::NonNegativeNumber);
   app.add_option("--composites", s.composites, "Composites of real frames")->check(CLI::NonNegativeNumber);
   app.add_option("--split", s.split, "Which half: reporting (figures to quote) or choosing (to choose settings on)")
       ->check(CLI::IsMember({"reporting", "choosing"}));
   app.add_option("--cast-step", s.cast_step, "Every n-th real frame of each video under each cast")
       ->check(AtLeastOne());
-  app.add_option("--threads", s.threads, "Recognizer worker threads")->check(AtLeastOne());
-  app.add_flag("--track", s.track, "Also track along the cast videos (recognize --track)");
+  app.add_flag("--track", s.track,
+               "Also track along the cast videos (recognize --track; with --search-every, searching every N-th frame)");
   app.add_option("--figures", s.figures, "Folder of the pictures (one per set)");
   app.add_option("--figure-format", s.figure_format, "Picture format")->check(CLI::IsMember({"jpg", "png"}));
   app.add_option("--results", s.results, "Markdown file the report goes to");
+  app.add_option("--detections", s.detections,
+                 "JSON Lines file every run's detections are appended to, per frame with their verification terms "
+                 "and which were right");
+  s.recognizer.options.ransac.threads = 2;  // the benchmark machine's cores
+  AddSettingFlags(app, &s.recognizer, {"hypotheses", "track"},
+                  "Settings of every run (as `ecvpose recognize` takes them)");
   if (const auto exit_code = ParseCommandLine(app, argc, argv)) return *exit_code;
+  if (s.hypotheses.empty()) s.hypotheses = {HypothesisSourceName(s.recognizer.options.point_pairs.source)};
+  if (s.seeds.empty()) s.seeds = {s.recognizer.options.ransac.seed};
   const SplitHalf half = s.split == "choosing" ? SplitHalf::kChoosing : SplitHalf::kReporting;
 
   const auto start = std::chrono::steady_clock::now();
@@ -353,9 +394,9 @@ int Main(int argc, char** argv) {
     for (const BenchFrame& frame : frames) ++per_set[frame.set];
     text << "The " << SplitHalfName(half) << " half: " << per_set["rendered"] << " rendered scenes, "
          << per_set["composite"] << " composites, " << per_set["cast"] << " cast frames; library of "
-         << library.models().size() << " models (`" << s.db << "`), " << s.threads << " threads. Generating took "
-         << Fixed(generate_s, 0) << " s, " << runs.size() << " of " << planned << " runs " << Fixed(total_s / 60.0, 1)
-         << " min in all.\n\n"
+         << library.models().size() << " models (`" << s.db << "`), " << s.recognizer.options.ransac.threads
+         << " threads. Generating took " << Fixed(generate_s, 0) << " s, " << runs.size() << " of " << planned
+         << " runs " << Fixed(total_s / 60.0, 1) << " min in all.\n\n"
          << ConditionTable(runs, frames) << "\nWhere the false positives lie (nearest object within 6 cm; the "
          << "same object within 10 cm), and the objects by side: plain when the mean grey gradient over the "
          << "visible pixels is under " << kPlainGradient << " (grey objects counted apart).\n\n"
@@ -369,6 +410,7 @@ int Main(int argc, char** argv) {
                   CommandLine(argc, argv), text.str());
   };
   const auto add_run = [&](Run run) {
+    if (!s.detections.empty()) AppendDetections(s.detections, run, frames);
     runs.push_back(std::move(run));
     if (runs.size() == 1 && !s.figures.empty())
       WriteFigures(library, runs.front(), frames, s.figures, tag, s.figure_format);
@@ -376,13 +418,17 @@ int Main(int argc, char** argv) {
   };
   for (const std::string& source : s.hypotheses) {
     for (const uint64_t seed : s.seeds) {
-      RecognizerOptions options;
+      RecognizerOptions options = s.recognizer.options;
       options.point_pairs.source = ParseHypothesisSource(source, "--hypotheses");
       options.ransac.seed = seed;
-      options.ransac.threads = s.threads;
       const std::string label = source + ", seed " + std::to_string(seed);
-      add_run(RunRecognizer(library, options, frames, models, label, false));
-      if (s.track) add_run(RunRecognizer(library, options, frames, models, label + ", --track", true));
+      add_run(RunRecognizer(library, options, {false, 1}, frames, models, label));
+      if (s.track) {
+        const int every = s.recognizer.stream.search_every;
+        const std::string tracking =
+            label + ", --track" + (every > 1 ? " --search-every " + std::to_string(every) : "");
+        add_run(RunRecognizer(library, options, {true, every}, frames, models, tracking));
+      }
     }
   }
   return 0;

@@ -7,10 +7,13 @@
 //
 //   scripts/build_ycbv_library /tmp/ycbv.sqlite --views 40 --distance 0.9
 //   scripts/build_lmo_library /tmp/lmo.sqlite --views 40 --distance 1.0
-//   recognize_bench --db /tmp/ycbv.sqlite [--lmo-db /tmp/lmo.sqlite] [--peers] [--track] [--search-every N]
+//   recognize_bench --db /tmp/ycbv.sqlite [--lmo-db /tmp/lmo.sqlite] [--peers] [--track] [--search-every N...]
 //                   [--confirm-every N...] [--confirm-first N...] [--track-score S] [--seeds S...]
-//                   [--threads N] [--bytes] [--preselect N] [--turned] [--casts] [--python EXE] [--figure F.jpg]
-//                   [--results bench/RESULTS.md] [--frames N]
+//                   [--threads N...] [--bytes] [--preselect N...] [--turned] [--casts] [--python EXE] [--figure F.jpg]
+//                   [--results bench/RESULTS.md] [--frames N] [the settings flags of `ecvpose recognize`]
+// Every setting of the recognizer's table (recognize/recognizer_settings.h) is a flag, as in `ecvpose recognize`,
+// and applies to every run of ours, but those that add runs: --threads, --preselect, --hypotheses, --track,
+// --search-every, --confirm-every and --confirm-first.
 // --threads N (N > 1) adds a run of ours with N worker threads: the same detections (checked), its own times.
 // --bytes adds a run of ours matching with ByteNeighbours (recognize --matcher bytes; needs AVX-512 VNNI).
 // --preselect N adds a run of ours searching only the N models a quick look scores best (recognize --preselect N).
@@ -44,6 +47,7 @@
 #include "recognize/evaluation.h"
 #include "recognize/recognition_stream.h"
 #include "recognize/recognizer.h"
+#include "recognize/settings_flags.h"
 
 namespace ecv::bench {
 namespace {
@@ -376,22 +380,21 @@ const Run& RunNamed(const Runs& runs, const std::string& name) {
 // Which methods RunAll runs.
 struct Methods {
   bool ours = true;                         ///< ECV with and without ICP
+  RecognizerOptions options;                ///< every run of ours starts from these (the settings table's flags)
   bool track = false;                       ///< ours also with the previous frame's detections as priors
-  int search_every = 1;                     ///< > 1: ours also tracking with a full search only every n-th frame
+  std::vector<int> search_every;            ///< each > 1: ours also tracking with a full search only every n-th frame
   bool peers = false;                       ///< PCL, OpenCV PPF and Open3D on the whole frames
   bool object_pixels = false;               ///< the peers also on the objects' pixels only
   std::string python = "/usr/bin/python3";  ///< the interpreter that runs the Open3D peer
-  bool bytes = false;   ///< ours also with MatchIndex::kBytes (recognize --matcher bytes; AVX-512 VNNI only)
-  int preselect = 0;    ///< > 0: ours also searching only this many pre-selected models (recognize --preselect)
-  int threads = 1;      ///< > 1: ours also with this many worker threads (the same detections, faster)
-  bool turned = false;  ///< ours also on the frames turned 180 degrees (a camera held upside down)
-  bool casts = false;   ///< ours also on the frames under each ColorCasts() light (and each seed)
+  bool bytes = false;          ///< ours also with MatchIndex::kBytes (recognize --matcher bytes; AVX-512 VNNI only)
+  std::vector<int> preselect;  ///< each > 0: ours also searching only this many pre-selected models
+  std::vector<int> threads;    ///< each > 1: ours also with this many worker threads (the same detections, faster)
+  bool turned = false;         ///< ours also on the frames turned 180 degrees (a camera held upside down)
+  bool casts = false;          ///< ours also on the frames under each ColorCasts() light (and each seed)
   std::vector<std::string> hypotheses;  ///< ours also with these hypothesis sources (recognize --hypotheses)
   std::vector<uint64_t> seeds;          ///< ours, the hypothesis and the tracking runs repeated with these seeds
   std::vector<int> confirm_every;       ///< tracking also with each of these TrackingOptions::confirm_every
   std::vector<int> confirm_first;       ///< ... and each of these TrackingOptions::confirm_first
-  double track_score = -1.0;            ///< >= 0: tracking's TrackingOptions::min_follow_score
-  bool keep_plane = false;              ///< point pairs also vote with the scene's dominant plane
 };
 
 // The `methods` on `frames` with the library at `db`.
@@ -407,8 +410,7 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
                           [](const LibraryModel& model) { return model.color_matrix.has_value(); })
          << ". ";
   Runs runs;
-  RecognizerOptions options;
-  options.point_pairs.remove_plane = !methods.keep_plane;
+  RecognizerOptions options = methods.options;
   // A run of `settings` on `run_frames` labelled `label`, then one more per --seeds seed, labelled ", seed N".
   const auto add_seeded = [&](const std::string& label, RecognizerOptions settings,
                               const std::vector<NamedFrame>& run_frames) {
@@ -428,10 +430,11 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
         add_seeded(std::string(kOurs) + ", light " + name, options, CastFrames(frames, cast));
       }
     }
-    if (methods.threads > 1) {
+    for (const int threads : methods.threads) {
+      if (threads <= 1) continue;
       RecognizerOptions threaded = options;
-      threaded.ransac.threads = methods.threads;
-      const std::string label = "ECV + RANSAC + ICP, " + std::to_string(methods.threads) + " threads";
+      threaded.ransac.threads = threads;
+      const std::string label = "ECV + RANSAC + ICP, " + std::to_string(threads) + " threads";
       runs.emplace_back(label, RunRecognizer(library, threaded, frames, models, "threads"));
       *notes << label << ": detections " << (SameDetections(runs.front().second, runs.back().second) ? "" : "NOT ")
              << "identical to one thread's. ";
@@ -441,11 +444,11 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
       bytes.match.index = MatchIndex::kBytes;
       runs.emplace_back(kBytes, RunRecognizer(library, bytes, frames, models, "bytes"));
     }
-    if (methods.preselect > 0) {
+    for (const int preselect : methods.preselect) {
+      if (preselect <= 0) continue;
       RecognizerOptions preselecting = options;
-      preselecting.preselect.models = methods.preselect;
-      runs.emplace_back(Preselecting(methods.preselect),
-                        RunRecognizer(library, preselecting, frames, models, "preselect"));
+      preselecting.preselect.models = preselect;
+      runs.emplace_back(Preselecting(preselect), RunRecognizer(library, preselecting, frames, models, "preselect"));
     }
     for (const std::string& source : methods.hypotheses) {
       RecognizerOptions sourced = options;
@@ -458,12 +461,12 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
       }
     }
     if (methods.track) {
-      RecognizerOptions tracking = options;
-      if (methods.track_score >= 0.0) tracking.tracking.min_follow_score = methods.track_score;
+      const RecognizerOptions& tracking = options;
       runs.emplace_back(kTracking, RunRecognizer(library, tracking, frames, models, "track", true));
-      if (methods.search_every > 1) {
-        runs.emplace_back(TrackingEvery(methods.search_every),
-                          RunRecognizer(library, tracking, frames, models, "track every", true, methods.search_every));
+      for (const int every : methods.search_every) {
+        if (every <= 1) continue;
+        runs.emplace_back(TrackingEvery(every),
+                          RunRecognizer(library, tracking, frames, models, "track every", true, every));
       }
       std::vector<int> confirm_every = methods.confirm_every;
       if (confirm_every.empty()) confirm_every.push_back(tracking.tracking.confirm_every);
@@ -645,24 +648,16 @@ int main(int argc, char** argv) {
   app.add_flag("--object-pixels", methods.object_pixels,
                "Also run the peers on depth cut to the ground-truth objects' own pixels");
   app.add_flag("--track", methods.track, "Also run ours with the previous frame's detections as priors");
-  app.add_option_function<int>(
-         "--search-every",
-         [&methods](const int& every) {
-           methods.track = true;
-           methods.search_every = every;
-         },
-         "Implies --track; N > 1 also runs ours searching untracked models only every N-th frame (default: 1)")
-      ->check(AtLeastOne());
-  app.add_option("--confirm-every", methods.confirm_every,
-                 "With --track: tracking also with each of these confirm_every values (recognize --confirm-every), "
-                 "for each of --seeds");
-  app.add_option("--track-score", methods.track_score, "With --track: the follow score (recognize --track-score)");
-  app.add_option("--confirm-first", methods.confirm_first,
-                 "With --track: tracking also with each of these confirm_first values (recognize --confirm-first), "
-                 "for each --confirm-every and seed");
-  app.add_option("--threads", methods.threads, "N > 1 also runs ours with N worker threads (same detections checked)")
-      ->check(AtLeastOne())
-      ->capture_default_str();
+  AddSettingValues(app, "search-every", &methods.search_every,
+                   "Implies --track; each N > 1 also runs ours searching untracked models only every N-th frame");
+  AddSettingValues(app, "confirm-every", &methods.confirm_every,
+                   "With --track: tracking also with each of these confirm_every values (recognize --confirm-every), "
+                   "for each of --seeds");
+  AddSettingValues(app, "confirm-first", &methods.confirm_first,
+                   "With --track: tracking also with each of these confirm_first values (recognize --confirm-first), "
+                   "for each --confirm-every and seed");
+  AddSettingValues(app, "threads", &methods.threads,
+                   "Each N > 1 also runs ours with N worker threads (same detections checked)");
   app.add_flag_callback(
       "--bytes",
       [&methods] {
@@ -671,16 +666,12 @@ int main(int argc, char** argv) {
         methods.bytes = true;
       },
       "Also run ours matching with ByteNeighbours (recognize --matcher bytes; needs AVX-512 VNNI)");
-  app.add_option("--preselect", methods.preselect,
-                 "Also run ours searching only the N models a quick look scores best (default: no such run)")
-      ->check(AtLeastOne());
-  app.add_option("--hypotheses", methods.hypotheses,
-                 "Also run ours with these sources of pose hypotheses (ppf, both; recognize --hypotheses)")
-      ->check(CLI::IsMember({"context", "ppf", "both"}));
-  app.add_flag("--ppf-keep-plane", methods.keep_plane,
-               "Point pairs vote with the scene's dominant plane's points too (a table top; default: left out)");
+  AddSettingValues(app, "preselect", &methods.preselect,
+                   "Each N > 0 also runs ours searching only the N models a quick look scores best");
+  AddSettingValues(app, "hypotheses", &methods.hypotheses,
+                   "Also run ours with each of these sources of pose hypotheses (ppf, both; recognize --hypotheses)");
   app.add_option("--seeds", methods.seeds,
-                 "Also run ours (and each --hypotheses run) with these RANSAC seeds (the default run has seed 1)");
+                 "Also run ours (and each --hypotheses run) with these RANSAC seeds (the default run has --seed)");
   app.add_flag("--turned", methods.turned, "Also run ours on the frames turned 180 degrees (ground truth moved)");
   app.add_flag("--casts", methods.casts,
                "Also run ours on the frames under changed light: white balance 15 % warmer and cooler, gamma 0.8 and "
@@ -702,10 +693,16 @@ int main(int argc, char** argv) {
   app.add_option("--min-inlier-fraction", peer_options.min_inlier_fraction,
                  "Peers: share of a model's points within 1 cm of the scene after ICP to report it")
       ->capture_default_str();
+  RecognizerSettings settings;  // every run of ours: the table's flags but those above, which add runs
+  AddSettingFlags(app, &settings,
+                  {"threads", "preselect", "hypotheses", "track", "search-every", "confirm-every", "confirm-first"},
+                  "Settings of every run of ours (as `ecvpose recognize` takes them)");
   app.footer(
       "Libraries:\n  scripts/build_ycbv_library YCBV_LIB.sqlite --views 40 --distance 0.9\n"
       "  scripts/build_lmo_library LMO_LIB.sqlite --views 40 --distance 1.0");
   if (const auto exit_code = ParseCommandLine(app, argc, argv)) return *exit_code;
+  methods.options = settings.options;
+  methods.track = methods.track || !methods.search_every.empty();
   try {
     peer_options.Check();
     std::ostringstream markdown, notes;
@@ -731,22 +728,23 @@ int main(int argc, char** argv) {
                   "compared over 7-bit values, AVX-512 VNNI):\n\n"
                << TimingTable(RunNamed(runs, kBytes));
     }
-    if (methods.ours && methods.preselect > 0) {
-      markdown << "\nThe same searching only the " << methods.preselect
-               << " models that a quick look scores best (`recognize --preselect " << methods.preselect << "`):\n\n"
-               << TimingTable(RunNamed(runs, Preselecting(methods.preselect)));
+    for (const int preselect : methods.ours ? methods.preselect : std::vector<int>{}) {
+      if (preselect <= 0) continue;
+      markdown << "\nThe same searching only the " << preselect
+               << " models that a quick look scores best (`recognize --preselect " << preselect << "`):\n\n"
+               << TimingTable(RunNamed(runs, Preselecting(preselect)));
     }
     if (methods.ours && methods.track) {
       markdown << "\nThe same with tracking (each frame gets the previous frame's detections of its video as priors; "
                   "the first frame of each video has none):\n\n"
                << TimingTable(RunNamed(runs, kTracking));
-      if (methods.search_every > 1) {
-        markdown << "\nTracking with a full search only on the first frame of each video and then once every "
-                 << methods.search_every
+      for (const int every : methods.search_every) {
+        if (every <= 1) continue;
+        markdown << "\nTracking with a full search only on the first frame of each video and then once every " << every
                  << " frames; the frames in between follow the tracked objects and search only the models whose "
                     "track was lost (`recognize --track --search-every "
-                 << methods.search_every << "`):\n\n"
-                 << TimingTable(RunNamed(runs, TrackingEvery(methods.search_every)));
+                 << every << "`):\n\n"
+                 << TimingTable(RunNamed(runs, TrackingEvery(every)));
       }
     }
     if (!lmo_db.empty()) {

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Seed corpora of the fuzz targets, made from the real files of the shared data: copied, or trimmed to a few KB (JSON
-# to one image, meshes to their first faces, images and clouds to a crop through ecv_fuzz_seeds). Usage:
+# to one image, meshes to their first faces, images and clouds to a crop through ecv_fuzz_seeds); the request lines
+# of `ecvpose serve` from fuzz/corpus/serve_request (good and hostile ones, kept in the repository). Usage:
 #   fuzz/make_corpus.sh DATA_DIR BUILD_DIR    # writes BUILD_DIR/corpus/<target>/seed-*; inputs fuzzing added stay
 set -euo pipefail
 [ $# -eq 2 ] || { echo "usage: fuzz/make_corpus.sh DATA_DIR BUILD_DIR" >&2; exit 2; }
@@ -12,7 +13,7 @@ seeds() { ASAN_OPTIONS=detect_leaks=0 "$build/fuzz/ecv_fuzz_seeds" "$@"; }
 separator=$'\n--ecvfuzz-part--\n'  # fuzz_util.h's kPartSeparator
 rm -rf "$work"
 mkdir -p "$work"
-for target in png_frame frame_json ycbv_meta bop_scene pcd pose_json mesh_blob mesh; do
+for target in png_frame frame_json ycbv_meta bop_scene pcd pose_json mesh_blob mesh serve_request; do
   mkdir -p "$corpus/fuzz_$target"
 done
 
@@ -128,6 +129,10 @@ cp "$banana/textured_simple.obj.mtl" "$banana/texture_map.png" "$work/"
 sed -i 's|^mtllib .*|mtllib textured_simple.obj.mtl|' "$work/banana.obj"
 seeds mesh-blob "$work/banana.obj" "$corpus/fuzz_mesh_blob/seed-banana"
 seeds mesh-blob "$work/ape.ply" "$corpus/fuzz_mesh_blob/seed-ape"
+
+# Serve requests: the lines of fuzz/corpus/serve_request (tests/recognize/serve_request_test.cpp runs the target over
+# them in every ctest run).
+for line in "$(dirname "$0")"/corpus/serve_request/*; do cp "$line" "$corpus/fuzz_serve_request/seed-$(basename "$line")"; done
 
 for target_dir in "$corpus"/fuzz_*; do
   echo "corpus: $(basename "$target_dir"): $(find "$target_dir" -name 'seed-*' | wc -l) seeds," \

@@ -1,5 +1,7 @@
 #include "modeldb/library_build.h"
 
+#include <exception>
+
 #include "core/error.h"
 #include "modeldb/sql.h"
 #include "render/renderer.h"
@@ -27,6 +29,9 @@ LibraryBuildSummary BuildLibrary(const std::string& db_path, const std::vector<M
     } catch (const SqlError& error) {
       summary.failed.push_back(source.name);
       if (reporter.failed) reporter.failed(source, error.what());
+    } catch (const std::exception& error) {  // out of memory, a library's own error: this model's, not the build's
+      summary.failed.push_back(source.name);
+      if (reporter.failed) reporter.failed(source, source.mesh_path + ": " + error.what());
     }
   }
   return summary;

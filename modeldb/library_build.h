@@ -28,8 +28,8 @@ struct LibraryBuildSummary {
 
 /// Builds each of `sources` (BuildModel) and stores it in the library at `db_path`, created if missing and opened
 /// before any rendering, so that a bad path fails at once (InputError or SqlError). Each model is stored in one
-/// transaction and replaces a model of its name; one that fails (a bad mesh, a library that refuses it) is reported
-/// and the others are still built.
+/// transaction and replaces a model of its name; one that fails (a bad mesh or texture, a library that refuses it,
+/// any other exception of its build, such as running out of memory) is reported and the others are still built.
 LibraryBuildSummary BuildLibrary(const std::string& db_path, const std::vector<ModelSource>& sources,
                                  const ModelBuildOptions& options, const LibraryBuildReporter& reporter = {});
 

@@ -178,16 +178,16 @@ std::optional<Verified> ModelSearch::BestPose(int count, int give_up_after, cons
   const ViewCandidate* best_view = nullptr;
   for (size_t i = 0; i < std::min(ranked->size(), static_cast<size_t>(count)); ++i) {
     if (give_up_after > 0 && i == static_cast<size_t>(give_up_after) &&
-        (best_view == nullptr || best_view->verified->detection.score < options_.give_up_below_score)) {
+        (best_view == nullptr || best_view->verified->search_score < options_.give_up_below_score)) {
       break;
     }
     ViewCandidate& candidate = (*ranked)[i];
     Try(&candidate, times);
     if (!candidate.verified || CoveredShare(candidate.verified->surface, covered) > options_.max_overlap) continue;
-    if (best_view == nullptr || candidate.verified->detection.score > best_view->verified->detection.score) {
+    if (best_view == nullptr || candidate.verified->search_score > best_view->verified->search_score) {
       best_view = &candidate;
     }
-    if (options_.good_enough_score > 0.0 && best_view->verified->detection.score >= options_.good_enough_score) break;
+    if (options_.good_enough_score > 0.0 && best_view->verified->search_score >= options_.good_enough_score) break;
   }
   if (best_view == nullptr) return std::nullopt;
   std::optional<Verified> best = best_view->verified;
@@ -216,16 +216,16 @@ std::optional<Verified> ModelSearch::BestPose(int count, int give_up_after, cons
 const ViewCandidate* ModelSearch::TurnedRival(const std::vector<ViewCandidate>& ranked, int count,
                                               const ViewCandidate& best, const cv::Mat& covered) const {
   if (options_.rival_min_ratio <= 0.0) return nullptr;
-  const Detection& best_detection = best.verified->detection;
-  const Eigen::Matrix3d best_rotation = best_detection.camera_from_object.linear();
+  const double best_score = best.verified->search_score;
+  const Eigen::Matrix3d best_rotation = best.verified->detection.camera_from_object.linear();
   const ViewCandidate* rival = nullptr;
   for (size_t i = 0; i < std::min(ranked.size(), static_cast<size_t>(count)); ++i) {
     const ViewCandidate& candidate = ranked[i];
     if (&candidate == &best || !candidate.verified) continue;
-    const Detection& detection = candidate.verified->detection;
-    if (detection.score <= 0.0 || detection.score < options_.rival_min_ratio * best_detection.score) continue;
-    if (rival != nullptr && detection.score <= rival->verified->detection.score) continue;
-    const Eigen::AngleAxisd turn(best_rotation.transpose() * detection.camera_from_object.linear());
+    const double score = candidate.verified->search_score;
+    if (score <= 0.0 || score < options_.rival_min_ratio * best_score) continue;
+    if (rival != nullptr && score <= rival->verified->search_score) continue;
+    const Eigen::AngleAxisd turn(best_rotation.transpose() * candidate.verified->detection.camera_from_object.linear());
     if (turn.angle() <= M_PI / 2.0) continue;
     if (CoveredShare(candidate.verified->surface, covered) > options_.max_overlap) continue;
     rival = &candidate;

@@ -27,6 +27,9 @@ struct Hypothesis {
 /// scene's, which overlap suppression compares, and the rendered depth, from which ICP takes the model's surface.
 struct Verified {
   Detection detection;
+  /// The score without the continuation factor, by which the search chooses among coarse poses: before ICP a pose is
+  /// often a few pixels off, and its outline then lies on its own object's surface.
+  double search_score = 0.0;
   std::vector<cv::Point> surface;
   cv::Mat depth;
 };

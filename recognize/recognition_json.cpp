@@ -19,6 +19,7 @@ nlohmann::json RecognitionToJson(const RecognitionResult& result) {
                           {"visible_fraction", d.visible_fraction},
                           {"surface_error", d.surface_error_m},
                           {"contour_agreement", d.contour_agreement},
+                          {"continuation", d.continuation},
                           {"edge_agreement", d.edge_agreement},
                           {"edge_pixels", d.edge_pixels},
                           {"tracked", d.tracked},

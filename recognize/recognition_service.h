@@ -8,20 +8,12 @@
 #include "io/read_roots.h"
 #include "recognize/recognition_stream.h"
 #include "recognize/recognizer.h"
+#include "recognize/serve_request.h"
 
 namespace ecv {
 
-/// Bounds on one request line, checked before it is parsed: a line past them gets an error answer.
-struct RequestLimits {
-  size_t max_bytes = size_t{64} << 20;  ///< bytes of one line (64 MiB: room for a frame's images in base64)
-  int max_depth = 64;                   ///< nesting of [ and { (the serialiser recurses once per level)
-
-  /// Throws InputError for a bound < 1.
-  void Check() const;
-};
-
 /// The requests of `ecvpose serve`, one JSON object per line, and their responses: the rules of the protocol without
-/// its input and output, so that they are tested alone.
+/// its input and output, so that they are tested alone (ParseRequest reads a line, recognize/serve_request.h).
 ///
 /// A request names a frame, `{"frame": FRAME}` (what `recognize` takes) or `{"color": PATH, "depth": PATH,
 /// "depth_scale": S, "camera": [fx, fy, cx, cy]}`, with optional `"id"` (any JSON value, echoed), `"track"` (follow
@@ -53,7 +45,7 @@ class RecognitionService {
   void Reset() { stream_.Reset(); }
 
  private:
-  nlohmann::json Respond(const nlohmann::json& request);
+  nlohmann::json Respond(const ServeRequest& request);
 
   Recognizer& recognizer_;
   bool track_by_default_;

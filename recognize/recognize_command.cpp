@@ -79,10 +79,10 @@ void PrintDetections(std::ostream& out, const LoadedFrame& loaded, const Recogni
     out << "  " << std::left << std::setw(24) << d.model << std::right << " score " << d.score << " (depth "
         << d.depth_agreement << ", colour " << d.color_agreement << ", edges " << d.edge_agreement << " of "
         << d.edge_pixels << ", fit " << std::setprecision(1) << 1000.0 * d.surface_error_m << " mm"
-        << std::setprecision(2) << ", outline " << d.contour_agreement << "), inliers " << d.inlier_fraction
-        << ", view " << d.view << ", " << HypothesisSourceName(d.hypothesis) << (d.tracked ? ", tracked" : "")
-        << ", t = [" << std::setprecision(3) << d.camera_from_object.translation().transpose() << "] m"
-        << std::setprecision(2) << '\n';
+        << std::setprecision(2) << ", outline " << d.contour_agreement << ", runs on " << d.continuation
+        << "), inliers " << d.inlier_fraction << ", view " << d.view << ", " << HypothesisSourceName(d.hypothesis)
+        << (d.tracked ? ", tracked" : "") << ", t = [" << std::setprecision(3)
+        << d.camera_from_object.translation().transpose() << "] m" << std::setprecision(2) << '\n';
     for (const GroundTruth& truth : loaded.ground_truth) {
       if (truth.object_name != d.model) continue;
       out << "    vs ground truth: " << std::setprecision(1)

@@ -10,23 +10,23 @@
 #include <CLI/CLI.hpp>
 
 #include "modeldb/model_library.h"
-#include "recognize/recognition_stream.h"
 #include "recognize/recognizer.h"
+#include "recognize/recognizer_settings.h"
 
 namespace ecv::app {
 
-struct RecognizerArgs {
+/// The library and the settings table's flags (the recognizer's options and the stream's, as RecognizerSettings).
+struct RecognizerArgs : RecognizerSettings {
   std::string db;
   std::vector<std::string> models;  ///< --models: only these (empty: all)
-  RecognizerOptions options;
-  StreamOptions stream;  ///< --track, --search-every
-  std::string matcher = "kd-forest";
 };
 
-/// Declares --db, --models and the search, tracking and verification flags on `command`.
+/// Declares --db, --models and a flag per setting of the table (recognizer_settings.h) on `command`; --threads
+/// defaults to every core. The hidden --settings-json prints the table as JSON and exits.
 void AddRecognizerFlags(CLI::App& command, RecognizerArgs* args);
 
-/// The recognizer's options from the flags, checked: InputError naming the flag.
+/// The recognizer's options from the flags, checked (their ranges by the table as they are parsed, the rest by
+/// RecognizerOptions::Check).
 RecognizerOptions RecognizerOptionsFromArgs(const RecognizerArgs& args);
 
 /// A library loaded as the flags say and a recognizer over it (the library first: the recognizer reads it).

@@ -31,6 +31,33 @@ struct ModelSearchResult {
   StageTimes times;
 };
 
+// Whether `mesh` is painted in one colour (no texture; its vertex and material colours all within 2 % of one
+// another): a grey CAD mesh, whose render says nothing of the object's print (VerifyOptions::plain_appearance).
+bool OneColoured(const TriangleMesh& mesh) {
+  constexpr float kSame = 0.02F;  // RGB in [0, 1]
+  std::optional<Eigen::Vector3f> first;
+  const auto same = [&](const Eigen::Vector3f& color) {
+    if (!first) first = color;
+    return (color - *first).cwiseAbs().maxCoeff() <= kSame;
+  };
+  for (const MeshPart& part : mesh.parts) {
+    switch (mesh.Coloring(part)) {
+      case MeshColoring::kTexture: return false;
+      case MeshColoring::kVertexColor:
+        if (!std::all_of(part.colors.begin(), part.colors.end(), same)) return false;
+        break;
+      case MeshColoring::kMaterialColor:
+        const bool known = part.material >= 0 && part.material < static_cast<int>(mesh.materials.size());
+        if (!same(known ? mesh.materials[static_cast<size_t>(part.material)].diffuse_color
+                        : MeshMaterial().diffuse_color)) {
+          return false;
+        }
+        break;
+    }
+  }
+  return true;
+}
+
 RendererOptions VerificationRenderer(const RecognizerOptions& options) {
   options.Check();  // before anything is made of them
   RendererOptions renderer;
@@ -54,6 +81,7 @@ class Recognizer::Impl {
     std::vector<char> closed(models.size(), 0);  // per model: TriangleMesh::IsClosedOutward
     ppf_models_.resize(models.size());
     ppf_refusals_.resize(models.size());
+    plain_.resize(models.size());
     const bool point_pairs = options_.point_pairs.source != HypothesisSource::kContext;
     for (size_t first = 0; first < models.size(); first += batch) {
       std::vector<TriangleMesh> meshes(std::min(batch, models.size() - first));
@@ -62,6 +90,7 @@ class Recognizer::Impl {
         meshes[i] = ModelMesh(models[first + i].record);
         records_[first + i].mesh_blob = {};  // the copy's bytes: the renderer holds the mesh
         closed[first + i] = meshes[i].IsClosedOutward() ? 1 : 0;
+        plain_[first + i] = OneColoured(meshes[i]) ? 1 : 0;
         if (point_pairs) {
           ppf_models_[first + i] = MakePointPairModel(models[first + i].record, meshes[i], &ppf_refusals_[first + i]);
         }
@@ -369,16 +398,21 @@ class Recognizer::Impl {
         MeasurePose({rendered.color, rendered.depth}, scene.verification, to_scene, options_.verify);
     Verified verified;
     Detection& detection = verified.detection;
-    ScorePose(evidence, options_.verify, &detection);
+    ScorePose(evidence, options_.verify, plain_[model] != 0, &detection);
     detection.model = library_model.record.name;
     detection.camera_from_object = hypothesis.pose;
     detection.inlier_fraction = hypothesis.ransac.inlier_fraction;
     detection.fit_error_m = hypothesis.ransac.fit_error_m;
     detection.view = hypothesis.view;
-    if (options_.verify.reject_plane_patches && detection.score > 0.0 &&
+    VerifyOptions search = options_.verify;  // the search's score: without the continuation factor
+    search.continuation_falloff = 0.0;
+    Detection unjudged;
+    ScorePose(evidence, search, plain_[model] != 0, &unjudged);
+    verified.search_score = unjudged.score;
+    if (options_.verify.reject_plane_patches && verified.search_score > 0.0 &&
         OnLargerPlane(*scene.frame, rendered.depth, evidence.surface, options_.dense_stride_px,
                       options_.verify.plane_patch)) {
-      detection.score = 0.0;
+      detection.score = verified.search_score = 0.0;
     }
     verified.surface = std::move(evidence.surface);
     verified.depth = rendered.depth;
@@ -422,6 +456,7 @@ class Recognizer::Impl {
   std::vector<RenderOptions> render_options_;        // per model: shaded as its library views are
   std::vector<std::optional<PpfModel>> ppf_models_;  // per model, with point pair hypotheses: its table, if any
   std::vector<std::string> ppf_refusals_;            // per model without a table: why
+  std::vector<char> plain_;  // per model: painted in material colours alone (VerifyOptions::plain_appearance)
 };
 
 cv::Mat Recognizer::Impl::DrawDetections(const RgbdFrame& frame, const std::vector<Detection>& detections) {

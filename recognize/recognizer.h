@@ -22,7 +22,7 @@ namespace ecv {
 struct Detection {
   std::string model;
   /// 0..1, higher is surer: depth agreement x appearance (colour correlation and texture edges) of the rendered
-  /// model x its fit and contour factors
+  /// model x its fit, contour and continuation factors
   double score = 0.0;
   Eigen::Isometry3d camera_from_object = Eigen::Isometry3d::Identity();
   double inlier_fraction = 0.0;    ///< RANSAC inliers over the visible view primitives
@@ -32,6 +32,7 @@ struct Detection {
   double color_agreement = 0.0;    ///< correlation of the rendered colours with the scene's on those, 0..1
   double surface_error_m = 0.0;    ///< mean |rendered - scene depth| on those, metres
   double contour_agreement = 0.0;  ///< share of the seen outline on a scene depth step (0: none seen)
+  double continuation = 0.0;       ///< share of the judged outline across which the scene's surface runs on
   double visible_fraction = 0.0;   ///< share of the rendered pixels the scene can show (not hidden, with depth)
   /// Of the rendered model's texture edges on those, the share the scene shows (0: none predicted) ...
   double edge_agreement = 0.0;

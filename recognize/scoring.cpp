@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numeric>
 
+#include <Eigen/Dense>
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
@@ -172,6 +173,104 @@ OutlineOnSteps OutlineOnDepthSteps(const cv::Mat& rendered_depth, int stride, co
 double ContourFactor(const OutlineOnSteps& outline, double free, double falloff, int min_seen) {
   if (falloff <= 0.0 || outline.seen < min_seen) return 1.0;
   return std::clamp(1.0 - (free - outline.Share()) / falloff, 0.0, 1.0);
+}
+
+void ContinuationOptions::Check() const {
+  auto require = [](bool ok, const char* field, const char* expected) {
+    if (!ok) ThrowInputError("continuation options", field, expected);
+  };
+  require(window_px >= 2 && window_px <= 200, "window_px", "in [2, 200] pixels");
+  require(min_gap_px >= 0 && min_gap_px <= max_gap_px, "min_gap_px", ">= 0 and at most max_gap_px");
+  require(max_gap_px <= window_px, "max_gap_px", "at most window_px");
+  require(tolerance_m > 0.0, "tolerance_m", "> 0 m");
+  require(max_fit_rms_m > 0.0, "max_fit_rms_m", "> 0 m");
+  require(min_samples >= 3, "min_samples", "at least 3");
+}
+
+OutlineContinuation SurfaceContinuation(const cv::Mat& rendered_depth, int stride, const cv::Mat& scene_depth,
+                                        double surface_tolerance_m, const ContinuationOptions& options) {
+  options.Check();
+  if (rendered_depth.type() != CV_32FC1 || scene_depth.type() != CV_32FC1) {
+    ThrowInputError("surface continuation", "rendered_depth/scene_depth", "CV_32FC1 images in metres");
+  }
+  if (stride < 1 || rendered_depth.rows != (scene_depth.rows + stride - 1) / stride ||
+      rendered_depth.cols != (scene_depth.cols + stride - 1) / stride) {
+    ThrowInputError("surface continuation", "rendered_depth", "the scene depth's size / stride");
+  }
+  const int rows = rendered_depth.rows, cols = rendered_depth.cols;
+  // The scene at the render's samples, and where it shows the model's surface.
+  cv::Mat scene(rows, cols, CV_32FC1), surface = cv::Mat::zeros(rows, cols, CV_8UC1);
+  const auto on_surface_m = static_cast<float>(surface_tolerance_m);
+  for (int v = 0; v < rows; ++v) {
+    for (int u = 0; u < cols; ++u) {
+      const float z = scene_depth.at<float>(v * stride, u * stride);
+      const float model_z = rendered_depth.at<float>(v, u);
+      scene.at<float>(v, u) = z;
+      if (model_z > 0.0F && z > 0.0F && std::abs(z - model_z) <= on_surface_m) surface.at<uchar>(v, u) = 1;
+    }
+  }
+  // Distance of every sample off the model to the model's nearest one, in samples.
+  cv::Mat off_model = rendered_depth <= 0.0F, distance;
+  cv::distanceTransform(off_model, distance, cv::DIST_L2, 3);
+  const int window = std::max(1, options.window_px / stride);
+  const auto min_gap = static_cast<float>(options.min_gap_px) / static_cast<float>(stride);
+  const auto max_gap = static_cast<float>(options.max_gap_px) / static_cast<float>(stride);
+  const auto min_samples = static_cast<size_t>(options.min_samples);
+  auto on_model = [&](int u, int v) {
+    return u < 0 || v < 0 || u >= cols || v >= rows || rendered_depth.at<float>(v, u) > 0.0F;
+  };
+  OutlineContinuation continuation;
+  std::vector<cv::Point> outside;
+  for (int v = 0; v < rows; ++v) {
+    for (int u = 0; u < cols; ++u) {
+      if (surface.at<uchar>(v, u) == 0) continue;
+      if (on_model(u - 1, v) && on_model(u + 1, v) && on_model(u, v - 1) && on_model(u, v + 1)) continue;
+      // The surface inside as a plane: inverse depth is affine in the pixel coordinates for a plane.
+      const cv::Rect box =
+          cv::Rect(u - window, v - window, 2 * window + 1, 2 * window + 1) & cv::Rect(0, 0, cols, rows);
+      Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+      Eigen::Vector3d right = Eigen::Vector3d::Zero();
+      size_t inside = 0;
+      outside.clear();
+      for (int y = box.y; y < box.y + box.height; ++y) {
+        for (int x = box.x; x < box.x + box.width; ++x) {
+          if (surface.at<uchar>(y, x) != 0) {
+            const Eigen::Vector3d row(x - u, y - v, 1.0);
+            normal += row * row.transpose();
+            right += row / scene.at<float>(y, x);
+            ++inside;
+          } else if (rendered_depth.at<float>(y, x) <= 0.0F && distance.at<float>(y, x) >= min_gap &&
+                     distance.at<float>(y, x) <= max_gap && scene.at<float>(y, x) > 0.0F) {
+            outside.emplace_back(x, y);
+          }
+        }
+      }
+      if (inside < min_samples || outside.size() < min_samples) continue;
+      const Eigen::Vector3d plane = normal.ldlt().solve(right);
+      auto plane_depth = [&](int x, int y) { return 1.0 / plane.dot(Eigen::Vector3d(x - u, y - v, 1.0)); };
+      double squares = 0.0;
+      for (int y = box.y; y < box.y + box.height; ++y) {
+        for (int x = box.x; x < box.x + box.width; ++x) {
+          if (surface.at<uchar>(y, x) == 0) continue;
+          const double residual = scene.at<float>(y, x) - plane_depth(x, y);
+          squares += residual * residual;
+        }
+      }
+      if (!(std::sqrt(squares / static_cast<double>(inside)) <= options.max_fit_rms_m)) continue;
+      const auto on_plane = std::count_if(outside.begin(), outside.end(), [&](const cv::Point& p) {
+        const double z = plane_depth(p.x, p.y);
+        return z > 0.0 && std::abs(scene.at<float>(p) - z) <= options.tolerance_m;
+      });
+      ++continuation.tested;
+      if (2 * static_cast<size_t>(on_plane) > outside.size()) ++continuation.continued;
+    }
+  }
+  return continuation;
+}
+
+double ContinuationFactor(const OutlineContinuation& continuation, double free, double falloff, int min_tested) {
+  if (falloff <= 0.0 || continuation.tested < min_tested) return 1.0;
+  return std::clamp(1.0 - (continuation.Share() - free) / falloff, 0.0, 1.0);
 }
 
 cv::Mat GreyGradient(const cv::Mat& grey) {

@@ -74,10 +74,52 @@ struct OutlineOnSteps {
 OutlineOnSteps OutlineOnDepthSteps(const cv::Mat& rendered_depth, int stride, const cv::Mat& scene_depth,
                                    const cv::Mat& scene_steps, double hidden_margin_m);
 
+/// When the scene's surface runs on across a pose's outline (SurfaceContinuation): the model would then explain only
+/// part of a larger surface, as a small box laid flush on a bigger box's face does.
+struct ContinuationOptions {
+  /// A plane is fitted to the scene's surface samples within this of an outline pixel; frame pixels.
+  int window_px = 12;
+  /// The scene samples tested lie this far from the silhouette: not closer, where a pose a pixel or two off still
+  /// has its own object and a crease has not yet turned far from the plane, nor further; frame pixels.
+  int min_gap_px = 3;
+  int max_gap_px = 12;
+  /// A scene sample beyond the outline continues the surface when its depth lies within this of the plane; metres.
+  double tolerance_m = 0.004;
+  /// Where the surface inside is not one plane within this (rms of depth), the outline pixel decides nothing
+  /// (a crease or a curve under the window); metres.
+  double max_fit_rms_m = 0.002;
+  int min_samples = 6;  ///< on each side of the outline pixel; fewer decide nothing
+
+  /// Throws InputError on values outside their ranges.
+  void Check() const;
+};
+
+/// Seen outline pixels of a rendered pose that could be judged, and across how many of them the scene's surface
+/// continues.
+struct OutlineContinuation {
+  int tested = 0;
+  int continued = 0;
+  double Share() const { return tested > 0 ? static_cast<double>(continued) / tested : 0.0; }
+};
+
+/// Whether the scene's surface ends where a posed model's outline says the object ends. For each outline pixel of
+/// `rendered_depth` (as in OutlineOnDepthSteps) that the scene shows on the model's surface (within
+/// `surface_tolerance_m`), a plane is fitted to the scene's surface samples around it, and the scene samples just
+/// beyond the outline are tested against it: most of them on the plane means the surface continues there. A right
+/// pose's outline runs along depth steps and creases (an object standing on a table meets it at an angle); a model
+/// laid over part of a larger surface has the rest of that surface all round it. Throws InputError when the images
+/// do not fit.
+OutlineContinuation SurfaceContinuation(const cv::Mat& rendered_depth, int stride, const cv::Mat& scene_depth,
+                                        double surface_tolerance_m, const ContinuationOptions& options = {});
+
 /// Verification's contour factor: 1 when fewer than `min_seen` outline pixels are seen (an object cut off by the
 /// image all round, or hidden but for a patch: the outline cannot tell), else 1 from a share of `free` on the
 /// steps, falling linearly to 0 over `falloff` below; `falloff` 0: always 1.
 double ContourFactor(const OutlineOnSteps& outline, double free, double falloff, int min_seen);
+
+/// Verification's continuation factor: 1 when fewer than `min_tested` outline pixels could be judged, else 1 up to a
+/// continued share of `free`, falling linearly to 0 over `falloff` above; `falloff` 0: always 1.
+double ContinuationFactor(const OutlineContinuation& continuation, double free, double falloff, int min_tested);
 
 /// Image gradients of a grey image (CV_8UC1): 3x3 Sobel, CV_32FC2 (d/du, d/dv). Throws InputError on another type.
 cv::Mat GreyGradient(const cv::Mat& grey);

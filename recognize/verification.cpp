@@ -23,9 +23,13 @@ void VerifyOptions::Check() const {
   require(contour_falloff >= 0.0, "contour_falloff", ">= 0 (0: no contour factor)");
   require(depth_step_m > 0.0, "depth_step_m", "> 0 m");
   require(min_outline_samples >= 0, "min_outline_samples", ">= 0");
+  require(continuation_free >= 0.0 && continuation_free <= 1.0, "continuation_free", "in [0, 1]");
+  require(continuation_falloff >= 0.0, "continuation_falloff", ">= 0 (0: no continuation factor)");
+  continuation.Check();
   require(edge_weight >= 0.0 && edge_weight <= 1.0, "edge_weight", "in [0, 1] (0: colour alone)");
   require(min_edge_pixels >= 1, "min_edge_pixels", "at least 1");
   edge.Check();
+  require(plain_appearance >= 0.0 && plain_appearance <= 1.0, "plain_appearance", "in [0, 1] (0: by colours)");
   require(min_score >= 0.0 && min_score <= 1.0, "min_score", "in [0, 1]");
   require(min_visible_fraction >= 0.0 && min_visible_fraction <= 1.0, "min_visible_fraction", "in [0, 1]");
   plane_patch.Check();
@@ -106,6 +110,10 @@ PoseEvidence MeasurePose(const RenderedPose& rendered, const VerificationFrame& 
   evidence.edges = CompareEdges(GreyGradient(model_grey), frame.gradient, interior_surface, options.edge);
   evidence.outline =
       OutlineOnDepthSteps(rendered.depth, stride, frame.depth, frame.depth_steps, options.depth_tolerance_m);
+  if (options.continuation_falloff > 0.0) {
+    evidence.continuation =
+        SurfaceContinuation(rendered.depth, stride, frame.depth, options.depth_tolerance_m, options.continuation);
+  }
   return evidence;
 }
 
@@ -114,7 +122,7 @@ double FitFactor(double residual_m, const VerifyOptions& options) {
   return std::clamp(1.0 - (residual_m - options.residual_free_m) / options.residual_falloff_m, 0.0, 1.0);
 }
 
-void ScorePose(const PoseEvidence& evidence, const VerifyOptions& options, Detection* detection) {
+void ScorePose(const PoseEvidence& evidence, const VerifyOptions& options, bool plain, Detection* detection) {
   const auto on_surface = static_cast<int>(evidence.surface.size());
   detection->color_agreement = evidence.color_agreement;
   detection->edge_agreement = evidence.edges.Share();
@@ -124,12 +132,16 @@ void ScorePose(const PoseEvidence& evidence, const VerifyOptions& options, Detec
   detection->depth_agreement = evidence.visible > 0 ? static_cast<double>(on_surface) / evidence.visible : 0.0;
   detection->surface_error_m = evidence.surface_error_m;
   detection->contour_agreement = evidence.outline.Share();
+  detection->continuation = evidence.continuation.Share();
   const double contour =
       ContourFactor(evidence.outline, options.contour_free, options.contour_falloff, options.min_outline_samples);
-  detection->score =
-      detection->depth_agreement *
-      Appearance(evidence.color_agreement, evidence.edges, options.edge_weight, options.min_edge_pixels) *
-      FitFactor(evidence.surface_error_m, options) * contour;
+  const double appearance =
+      plain && options.plain_appearance > 0.0
+          ? options.plain_appearance
+          : Appearance(evidence.color_agreement, evidence.edges, options.edge_weight, options.min_edge_pixels);
+  detection->score = detection->depth_agreement * appearance * FitFactor(evidence.surface_error_m, options) * contour *
+                     ContinuationFactor(evidence.continuation, options.continuation_free, options.continuation_falloff,
+                                        options.min_outline_samples);
 }
 
 bool OnLargerPlane(const RgbdFrame& frame, const cv::Mat& rendered_depth, const std::vector<cv::Point>& surface,

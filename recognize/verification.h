@@ -13,8 +13,8 @@ namespace ecv {
 struct Detection;
 
 /// How a pose is verified: the model is rendered at it and compared with the frame (beyond the paper). The score
-/// is depth agreement x appearance x fit factor x contour factor; bench/RESULTS.md, "Recognizer defaults", says
-/// how each default was chosen.
+/// is depth agreement x appearance x fit, contour and continuation factors; bench/RESULTS.md, "Recognizer defaults",
+/// says how each default was chosen.
 struct VerifyOptions {
   /// A rendered pixel lies on the scene surface when their depths differ by at most this; a scene surface further
   /// than this in front hides it. Metres.
@@ -33,11 +33,22 @@ struct VerifyOptions {
   double contour_falloff = 0.2;
   double depth_step_m = 0.01;
   int min_outline_samples = 20;
+  /// Continuation factor: 1 up to a share of continuation_free of the judged outline across which the scene's surface
+  /// runs on (SurfaceContinuation), falling linearly to 0 over continuation_falloff above (0: no factor); 1 when
+  /// fewer than min_outline_samples outline samples could be judged. A model that covers part of a surface loses to
+  /// one that covers all of it.
+  double continuation_free = 0.4;
+  double continuation_falloff = 0.3;
+  ContinuationOptions continuation;
   /// Appearance: colour correlation^(1 - edge_weight) x share of the model's texture edges the scene shows^edge_weight
   /// (CompareEdges), colour alone when fewer than min_edge_pixels edges are predicted.
   double edge_weight = 0.5;
   int min_edge_pixels = 50;
   EdgeOptions edge;
+  /// A model painted in one colour (no texture, one vertex or material colour: a grey CAD mesh) says nothing of the
+  /// object's print: its appearance term is this instead, and it is judged by its geometry (0: by its colours, as
+  /// any model).
+  double plain_appearance = 0.5;
   double min_score = 0.3;             ///< poses below are not detections
   double min_visible_fraction = 0.1;  ///< nor poses of which the scene can show less than this share
   /// A pose whose surface is one patch of a larger scene plane scores 0 (PatchOfLargerPlane): the depth shows
@@ -81,10 +92,11 @@ struct PoseEvidence {
   int visible = 0;          ///< ... of them with a scene depth that does not hide them
   /// Frame pixels where the rendered surface lies on the scene's (within depth_tolerance_m), at the stride.
   std::vector<cv::Point> surface;
-  double surface_error_m = 0.0;  ///< mean |rendered - scene depth| on `surface`, metres
-  double color_agreement = 0.0;  ///< ColorCorrelation of the rendered colours with the scene's on `surface`
-  EdgeAgreement edges;           ///< the model's texture edges inside its silhouette, and those the scene shows
-  OutlineOnSteps outline;        ///< the seen outline, and how much of it lies on scene depth steps
+  double surface_error_m = 0.0;      ///< mean |rendered - scene depth| on `surface`, metres
+  double color_agreement = 0.0;      ///< ColorCorrelation of the rendered colours with the scene's on `surface`
+  EdgeAgreement edges;               ///< the model's texture edges inside its silhouette, and those the scene shows
+  OutlineOnSteps outline;            ///< the seen outline, and how much of it lies on scene depth steps
+  OutlineContinuation continuation;  ///< the judged outline, and across how much of it the scene's surface runs on
 };
 
 /// Compares `rendered` with `frame` (made with the same stride); `model_to_scene` maps the rendered colours (a
@@ -93,8 +105,10 @@ PoseEvidence MeasurePose(const RenderedPose& rendered, const VerificationFrame& 
                          const Eigen::Matrix3f& model_to_scene, const VerifyOptions& options);
 
 /// Fills `detection`'s verification terms (depth, colour and edge agreement, surface error, contour agreement,
-/// visible fraction) and its score from `evidence`: depth agreement x Appearance x FitFactor x ContourFactor.
-void ScorePose(const PoseEvidence& evidence, const VerifyOptions& options, Detection* detection);
+/// continuation, visible fraction) and its score from `evidence`: depth agreement x Appearance x FitFactor x
+/// ContourFactor x ContinuationFactor; for a `plain` model (one painted in one colour) with
+/// options.plain_appearance > 0, that value stands for Appearance.
+void ScorePose(const PoseEvidence& evidence, const VerifyOptions& options, bool plain, Detection* detection);
 
 /// Verification's fit factor of a mean surface residual (metres): 1 up to residual_free_m, falling linearly to 0
 /// over residual_falloff_m beyond; always 1 when residual_falloff_m is 0.

@@ -35,17 +35,10 @@ Returns the names of the models built. Raises InputError naming each model that 
 
 inline constexpr const char* kRecognizerDoc = R"(Recognizer(library, **options): a recognizer over `library`.
 
-The options are the flags of `ecvpose recognize` with underscores, with the same defaults:
-threads=2, seed=1: worker threads, 1 to 256 (the result is the same for any count), and the random seed.
-track=False: follow objects from call to call (each previous detection tried first at its pose);
-search_every=1: with track, models not followed are searched on every N-th call only;
-track_score=0.3: a detection is followed only while it scores at least this;
-confirm_every=5: a followed object's model is searched again after this many frames (0: never).
-hypotheses="context": where poses come from, "context", "ppf" or "both".
-views_per_model, good_enough_score, give_up_after, give_up_score, preselect, ranking_checks, min_score,
-max_instances: the search; icp=True, fast_icp=False, nearest_inliers=False, contour=True, edge_weight,
-matcher="kd-forest" ("bytes"): refinement, RANSAC's inliers and verification.
-An unknown keyword or a value out of range raises InputError naming it.
+The options are the settings of `ecvpose recognize`, its flags with underscores (views_per_model for
+--views-per-model; icp and contour, True by default, for --no-icp and --no-contour), with the same defaults but
+threads=2 (the CLI takes every core). An unknown keyword or a value out of range raises InputError naming it.
+Recognizer.settings shows the values a recognizer runs with.
 
 Loads the models' meshes for verification (about a second for seven models).)";
 

@@ -1,21 +1,23 @@
 // The Python module's Frame, load_frame, Detection and Recognizer.
 
+#include <algorithm>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <sstream>
 #include <string>
+#include <variant>
 
 #include <pybind11/stl.h>
 
 #include "arrays.h"
 #include "bindings.h"
 #include "core/error.h"
-#include "core/parallel.h"
 #include "io/frame_io.h"
 #include "library.h"
 #include "recognize/recognition_stream.h"
 #include "recognize/recognizer.h"
+#include "recognize/recognizer_settings.h"
 
 namespace ecv::python {
 namespace {
@@ -23,8 +25,11 @@ namespace {
 // A Recognizer with its library and its stream of frames: one call at a time (the renderer is not shared).
 class StreamRecognizer {
  public:
-  StreamRecognizer(std::shared_ptr<Library> library, const RecognizerOptions& options, const StreamOptions& stream)
-      : library_(std::move(library)), recognizer_(library_->library(), options), stream_(recognizer_, stream) {}
+  StreamRecognizer(std::shared_ptr<Library> library, const RecognizerSettings& settings)
+      : library_(std::move(library)),
+        settings_(settings),
+        recognizer_(library_->library(), settings.options),
+        stream_(recognizer_, settings.stream) {}
 
   RecognitionResult Recognize(const RgbdFrame& frame) {
     const std::lock_guard<std::mutex> lock(mutex_);
@@ -50,46 +55,25 @@ class StreamRecognizer {
 
   std::vector<std::string> PointPairWarnings() const { return recognizer_.PointPairWarnings(); }
 
+  const RecognizerSettings& settings() const { return settings_; }
+
  private:
   std::shared_ptr<Library> library_;  // the recognizer reads it
+  RecognizerSettings settings_;
   Recognizer recognizer_;
   RecognitionStream stream_;
   std::mutex mutex_;
   std::map<std::string, double> last_timings_ms_;
 };
 
-// The Recognizer's keyword arguments: the flags of `ecvpose recognize`.
-struct RecognizeArguments {
-  int threads = 2;
-  uint64_t seed = 1;
-  bool track = false;
-  int search_every = 1;
-  RecognizerOptions options;
-};
+// The Python Recognizer's default thread count (the CLI's: every core); the other defaults are the table's.
+constexpr int kPythonThreads = 2;
 
-std::unique_ptr<StreamRecognizer> MakeRecognizer(std::shared_ptr<Library> library, RecognizeArguments args) {
-  args.options.ransac.threads = args.threads;
-  args.options.ransac.seed = args.seed;
-  args.options.Check();
-  StreamOptions stream;
-  stream.track = args.track;
-  stream.search_every = args.search_every;
-  stream.Check();
-  if (library->library().models().empty()) {
-    ThrowInputError(library->path(), "models", "a library with at least one model", "none");
-  }
+std::unique_ptr<StreamRecognizer> MakeRecognizer(std::shared_ptr<Library> library, const RecognizerSettings& settings) {
+  CheckSettings(settings);
+  RequireModels(library->library(), library->path());
   py::gil_scoped_release release;  // the meshes are loaded and uploaded: about a second
-  return std::make_unique<StreamRecognizer>(std::move(library), args.options, stream);
-}
-
-// A keyword argument outside [low, high] is an InputError naming it.
-void CheckRange(const char* name, double value, double low, double high) {
-  if (!(value >= low && value <= high)) {
-    std::ostringstream expected, got;
-    expected << "a value in [" << low << ", " << high << "]";
-    got << value;
-    ThrowInputError(name, "", expected.str(), got.str());
-  }
+  return std::make_unique<StreamRecognizer>(std::move(library), settings);
 }
 
 template <typename T>
@@ -101,70 +85,56 @@ T Cast(const std::string& key, const py::handle& value, const char* expected) {
   }
 }
 
-// One keyword argument of Recognizer, checked and set as the recognize flag of that name.
-void SetKeyword(const std::string& key, const py::handle& value, RecognizeArguments* args) {
-  RecognizerOptions& o = args->options;
-  const auto number = [&](double low, double high) {
-    const double x = Cast<double>(key, value, "a number");
-    CheckRange(key.c_str(), x, low, high);
-    return x;
-  };
-  const auto count = [&](int low, double high = 1e9) {
-    const int n = Cast<int>(key, value, "a whole number");
-    CheckRange(key.c_str(), n, low, high);
-    return n;
-  };
-  const auto flag = [&] { return Cast<bool>(key, value, "True or False"); };
-  if (key == "threads") {
-    args->threads = count(1, kMaxThreads);
-  } else if (key == "seed") {
-    args->seed = static_cast<uint64_t>(count(0));
-  } else if (key == "track") {
-    args->track = flag();
-  } else if (key == "search_every") {
-    args->search_every = count(1);
-  } else if (key == "track_score") {
-    o.tracking.min_follow_score = number(0, 1);
-  } else if (key == "confirm_every") {
-    o.tracking.confirm_every = count(0);
-  } else if (key == "confirm_first") {
-    o.tracking.confirm_first = count(0);
-  } else if (key == "hypotheses") {
-    o.point_pairs.source = ParseHypothesisSource(Cast<std::string>(key, value, "a string"), key);
-  } else if (key == "views_per_model") {
-    o.views_per_model = count(1);
-  } else if (key == "good_enough_score") {
-    o.good_enough_score = number(0, 1e9);
-  } else if (key == "give_up_after") {
-    o.give_up_after_views = count(0);
-  } else if (key == "give_up_score") {
-    o.give_up_below_score = number(0, 1e9);
-  } else if (key == "preselect") {
-    o.preselect.models = count(0);
-  } else if (key == "ranking_checks") {
-    o.ranking.checks = count(0);
-  } else if (key == "min_score") {
-    o.verify.min_score = number(0, 1);
-  } else if (key == "max_instances") {
-    o.max_instances = count(1);
-  } else if (key == "icp") {
-    o.refine = flag();
-  } else if (key == "fast_icp") {
-    o.projective_icp = flag();
-  } else if (key == "nearest_inliers") {
-    o.projective_inliers = !flag();
-  } else if (key == "contour") {
-    o.verify.contour_falloff = flag() ? RecognizerOptions().verify.contour_falloff : 0.0;
-  } else if (key == "edge_weight") {
-    o.verify.edge_weight = number(0, 1);
-  } else if (key == "matcher") {
-    const std::string matcher = Cast<std::string>(key, value, "a string");
-    if (matcher != "kd-forest" && matcher != "bytes") ThrowInputError(key, "", "kd-forest or bytes", matcher);
-    o.match.index = matcher == "bytes" ? MatchIndex::kBytes : RecognizerOptions().match.index;
-  } else {
+// One keyword argument of Recognizer: the setting of the table with that keyword (the recognize flag with
+// underscores), checked by the table.
+void SetKeyword(const std::string& key, const py::handle& value, RecognizerSettings* settings) {
+  const Setting* setting = FindSetting(key);
+  if (setting == nullptr || setting->Keyword() != key) {
     ThrowInputError("Recognizer", key, "a keyword of the recognize flags (see help(ecvpose.Recognizer))",
                     "an unknown keyword");
   }
+  SettingValue typed;
+  switch (setting->type) {
+    case SettingType::kCount: typed = Cast<int64_t>(key, value, "a whole number"); break;
+    case SettingType::kNumber: typed = Cast<double>(key, value, "a number"); break;
+    case SettingType::kFlag: typed = Cast<bool>(key, value, "True or False"); break;
+    case SettingType::kChoice: typed = Cast<std::string>(key, value, "a string"); break;
+  }
+  setting->Set(typed, key, settings);
+}
+
+// The settings as keyword -> value (what Recognizer.settings shows).
+py::dict SettingsDict(const RecognizerSettings& settings) {
+  py::dict values;
+  for (const Setting& setting : RecognizerSettingTable()) {
+    std::visit([&](const auto& value) { values[py::str(setting.Keyword())] = value; }, setting.get(settings));
+  }
+  return values;
+}
+
+// help(ecvpose.Recognizer): the keywords with their defaults and help, from the table.
+std::string RecognizerDoc() {
+  RecognizerSettings defaults;
+  defaults.options.ransac.threads = kPythonThreads;
+  std::ostringstream doc;
+  doc << kRecognizerDoc
+      << "\n\nKeywords (the flags of `ecvpose recognize` with underscores; default, then what it "
+         "does):\n";
+  for (const Setting& setting : RecognizerSettingTable()) {
+    std::string help = setting.help;
+    std::replace(help.begin(), help.end(), '\n', ' ');
+    const SettingValue value = setting.get(defaults);
+    doc << setting.Keyword() << '=';
+    if (setting.type == SettingType::kFlag) {
+      doc << (std::get<bool>(value) ? "True" : "False") << (setting.negated ? " (False: " : " (True: ");
+    } else if (setting.type == SettingType::kChoice) {
+      doc << '"' << setting.Format(value) << "\" (" << setting.Expected() << "): ";
+    } else {
+      doc << setting.Format(value) << " (" << setting.Expected() << "): ";
+    }
+    doc << help << (setting.type == SettingType::kFlag ? ")" : "") << "\n";
+  }
+  return doc.str();
 }
 
 py::list DetectionList(const RecognitionResult& result) {
@@ -237,6 +207,7 @@ void BindDetection(py::module_& m) {
       .def_readonly("color_agreement", &Detection::color_agreement)
       .def_readonly("surface_error_m", &Detection::surface_error_m)
       .def_readonly("contour_agreement", &Detection::contour_agreement)
+      .def_readonly("continuation", &Detection::continuation)
       .def_readonly("visible_fraction", &Detection::visible_fraction)
       .def_readonly("edge_agreement", &Detection::edge_agreement)
       .def_readonly("edge_pixels", &Detection::edge_pixels)
@@ -288,16 +259,17 @@ void BindFrame(py::module_& m) {
 }  // namespace
 
 void BindRecognizer(py::module_& m) {
+  static const std::string doc = RecognizerDoc();  // pybind11 keeps the pointer
   BindDetection(m);
   BindFrame(m);
   py::class_<StreamRecognizer>(m, "Recognizer", "Finds a library's models in RGB-D frames.")
       .def(py::init([](std::shared_ptr<Library> library, const py::kwargs& options) {
-             RecognizeArguments args;
-             args.options = RecognizerOptions();
-             for (const auto& [key, value] : options) SetKeyword(key.cast<std::string>(), value, &args);
-             return MakeRecognizer(std::move(library), std::move(args));
+             RecognizerSettings settings;
+             settings.options.ransac.threads = kPythonThreads;
+             for (const auto& [key, value] : options) SetKeyword(key.cast<std::string>(), value, &settings);
+             return MakeRecognizer(std::move(library), settings);
            }),
-           py::arg("library"), kRecognizerDoc)
+           py::arg("library"), doc.c_str())
       .def("recognize", &RecognizeArrays, py::arg("color"), py::arg("depth"), py::arg("K"),
            py::arg("depth_scale") = py::none(),
            "Detections in one frame, best score first. color: HxWx3 uint8 RGB; depth: HxW float32 metres (0: "
@@ -333,6 +305,9 @@ void BindRecognizer(py::module_& m) {
            "Forgets the tracks: the next frame searches every model (a new video).")
       .def_property_readonly("last_timings_ms", &StreamRecognizer::last_timings_ms,
                              "Time per stage of the last frame, milliseconds (\"total\": the whole call in C++).")
+      .def_property_readonly(
+          "settings", [](const StreamRecognizer& recognizer) { return SettingsDict(recognizer.settings()); },
+          "The keywords' values this recognizer runs with, {keyword: value}.")
       .def_property_readonly("point_pair_warnings", &StreamRecognizer::PointPairWarnings,
                              "Models without a point pair table, and why (with hypotheses \"ppf\" or \"both\").");
 }

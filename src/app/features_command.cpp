@@ -71,6 +71,7 @@ CommandAction SetupFeaturesCommand(CLI::App& command) {
   command.add_option("--out-json", args->out_json, "Counts per stage and timings as JSON");
   EcvOptions& options = args->options;
   command.add_option("--wavelength", options.monogenic.wavelength_px, "Centre wavelength of the band-pass, pixels")
+      ->check(AboveAtMost(2.0, MonogenicOptions::kMaxWavelengthPx))
       ->capture_default_str()
       ->group("Extraction");
   command.add_option("--spacing", options.grid_spacing_px, "Hexagonal grid spacing, pixels")

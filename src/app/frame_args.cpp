@@ -5,9 +5,12 @@
 #include <cstdlib>
 #include <functional>
 #include <iostream>
+#include <new>
+#include <sstream>
 #include <thread>
 #include <vector>
 
+#include "core/error.h"
 #include "core/parallel.h"
 #include "io/mesh_io.h"
 #include "io/pose_io.h"
@@ -29,9 +32,29 @@ void AddFrameFlags(CLI::App& command, FrameSpec* spec) {
       ->group("Frame from files");
 }
 
+namespace {
+
+// `load()`, with running out of memory (std::bad_alloc, or OpenCV's "Failed to allocate N bytes") as an InputError
+// naming `source`, the file being read: the readers bound what a file may claim, but not the memory left.
+template <typename Load>
+auto NamingTheFileOutOfMemory(const std::string& source, Load load) {
+  try {
+    return load();
+  } catch (const std::bad_alloc&) {
+    ThrowInputError(source, "memory", "a file whose contents fit in the memory left", "out of memory (std::bad_alloc)");
+  } catch (const cv::Exception& error) {
+    if (error.code != cv::Error::StsNoMem) throw;
+    ThrowInputError(source, "memory", "a file whose contents fit in the memory left",
+                    "out of memory (" + error.err + ")");
+  }
+}
+
+}  // namespace
+
 LoadedFrame LoadFrameWithWarnings(const FrameSpec& spec) {
   std::vector<std::string> warnings;
-  LoadedFrame frame = LoadFrame(spec, &warnings);
+  const std::string source = !spec.positional.empty() ? spec.positional : spec.color_path + ", " + spec.depth_path;
+  LoadedFrame frame = NamingTheFileOutOfMemory(source, [&] { return LoadFrame(spec, &warnings); });
   for (const std::string& warning : warnings) std::cerr << "ecvpose: warning: " << warning << '\n';
   return frame;
 }
@@ -79,6 +102,12 @@ CLI::Validator NonNegative() {
   return NumberCheck("a number >= 0", "NONNEGATIVE", [](double v) { return v >= 0.0; });
 }
 
+CLI::Validator AboveAtMost(double low, double high) {
+  std::ostringstream what;
+  what << "a number above " << low << " and at most " << high;
+  return NumberCheck(what.str(), "NUMBER", [low, high](double v) { return v > low && v <= high; });
+}
+
 void AddMeshFlags(CLI::App& command, MeshArgs* args) {
   command.add_option("--unit", args->unit, "Unit of mesh coordinates")
       ->check(CLI::IsMember({"m", "cm", "mm"}))
@@ -103,7 +132,7 @@ TriangleMesh LoadMeshWithArgs(const std::string& path, const MeshArgs& args) {
     options.object_from_mesh = ReadPoseFile(args.object_from_mesh_path, "object_from_mesh");
   }
   std::vector<std::string> warnings;
-  TriangleMesh mesh = LoadMesh(path, options, &warnings);
+  TriangleMesh mesh = NamingTheFileOutOfMemory(path, [&] { return LoadMesh(path, options, &warnings); });
   for (const std::string& warning : warnings) std::cerr << "ecvpose: warning: " << warning << '\n';
   return mesh;
 }

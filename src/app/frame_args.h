@@ -27,6 +27,8 @@ CLI::Validator OneTo(int most);  ///< a whole number from 1 to `most` (threads, 
 CLI::Validator ThreadCount();    ///< OneTo(kMaxThreads), for every --threads
 CLI::Validator Positive();       ///< a number > 0
 CLI::Validator NonNegative();    ///< a number >= 0
+/// A number above `low` and at most `high` (a wavelength, whose upper bound keeps its padding within memory).
+CLI::Validator AboveAtMost(double low, double high);
 
 /// The mesh flags shared by every subcommand that reads meshes.
 struct MeshArgs {

@@ -63,8 +63,11 @@ const FilterCache& Filters(cv::Size size, const MonogenicOptions& options) {
 }  // namespace
 
 void MonogenicOptions::Check() const {
-  if (!(wavelength_px > 2.0) || !std::isfinite(wavelength_px)) {
-    ThrowInputError("monogenic options", "wavelength_px", "a wavelength above 2 pixels", std::to_string(wavelength_px));
+  if (!(wavelength_px > 2.0 && wavelength_px <= kMaxWavelengthPx)) {
+    ThrowInputError(
+        "monogenic options", "wavelength_px",
+        "a wavelength above 2 and at most " + std::to_string(static_cast<int>(kMaxWavelengthPx)) + " pixels",
+        std::to_string(wavelength_px));
   }
   if (!(sigma_on_f > 0.0 && sigma_on_f < 1.0)) {
     ThrowInputError("monogenic options", "sigma_on_f", "a bandwidth ratio in (0, 1)", std::to_string(sigma_on_f));

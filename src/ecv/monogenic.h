@@ -6,7 +6,11 @@ namespace ecv {
 
 /// Band-pass of the monogenic signal (Felsberg & Sommer 2001): a radial log-Gabor filter.
 struct MonogenicOptions {
-  double wavelength_px = 12.0;  ///< centre wavelength of the log-Gabor band-pass, pixels (> 2)
+  /// The longest centre wavelength, pixels: the image is padded by a wavelength on each side (a longer one only
+  /// costs memory; it finds nothing in images of real sizes).
+  static constexpr double kMaxWavelengthPx = 1024.0;
+
+  double wavelength_px = 12.0;  ///< centre wavelength of the log-Gabor band-pass, pixels (> 2, <= kMaxWavelengthPx)
   double sigma_on_f = 0.55;     ///< bandwidth: sigma / f0 of the log-Gabor, in (0, 1); 0.55 is about 2 octaves
 
   /// Throws InputError on values outside the ranges above.

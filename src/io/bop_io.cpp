@@ -1,14 +1,17 @@
 // BOP scene images: SCENE_DIR/{scene_camera,scene_gt,scene_gt_info}.json, rgb/ (or gray/) and depth/
 // images named by the 6-digit image id. Depth in millimetres times depth_scale; poses in millimetres.
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <sstream>
 
 #include "core/error.h"
 #include "io/files.h"
 #include "io/frame_io.h"
+#include "io/image_bytes.h"
 #include "io/pose_io.h"
 #include "io/read_roots.h"
 
@@ -119,13 +122,23 @@ LoadedFrame LoadBopFrame(const std::string& scene_dir, int image_id, const std::
   const nlohmann::json& camera = ImageEntry(camera_file, camera_path, image_id);
   const std::vector<double> k = Numbers(camera, "cam_K", 9, camera_path);
   const double depth_scale_mm = OptionalNumber(camera, "depth_scale", 1.0, camera_path);  // mm = value * depth_scale
+  // The scene camera's values are its errors, before an image is read.
+  const std::string image = " (image " + std::to_string(image_id) + ")";
+  if (!(std::isfinite(depth_scale_mm) && depth_scale_mm > 0.0 && std::isfinite(1000.0 / depth_scale_mm))) {
+    std::ostringstream given;
+    given << depth_scale_mm;
+    ThrowInputError(camera_path, "depth_scale" + image,
+                    "a finite positive scale (millimetres = depth value x depth_scale)", given.str());
+  }
+  const std::array<double, 4> intrinsics = {k[0], k[4], k[2], k[5]};
+  CheckIntrinsics(intrinsics, camera_path, "cam_K" + image);
 
   const std::string color_path = ColorImageFile(scene_dir, image_id);
   const std::string depth_path =
       depth_override.empty() ? ImageFile(scene_dir, "depth", image_id, ".png") : depth_override;
 
   LoadedFrame loaded;
-  loaded.rgbd = MakeFrame(color_path, depth_path, 1000.0 / depth_scale_mm, {k[0], k[4], k[2], k[5]},
+  loaded.rgbd = MakeFrame(color_path, depth_path, 1000.0 / depth_scale_mm, intrinsics,
                           scene_dir + ":" + std::to_string(image_id));
   loaded.ground_truth = ReadBopGroundTruth(scene_dir, image_id);
   fs::path folder = fs::path(scene_dir).lexically_normal();

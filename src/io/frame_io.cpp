@@ -24,11 +24,6 @@ constexpr const char* kFrameForms =
     "a frame JSON, a YCB-Video prefix (.../0001/000001 with -color.png beside it), a BOP image "
     "SCENE_DIR:IMAGE_ID or an organized .pcd";
 
-void RequireFile(const std::string& path, const std::string& what) {
-  if (!PathExists(path)) ThrowInputError(path, what, "an existing file", "no such file");
-  if (IsDirectory(path)) ThrowInputError(path, what, "a file", "a directory");
-}
-
 bool EndsWith(const std::string& text, const std::string& suffix) {
   return text.size() >= suffix.size() && text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
@@ -68,9 +63,10 @@ LoadedFrame LoadPositional(const FrameSpec& spec) {
     if (!spec.color_path.empty() || spec.camera) {
       ThrowInputError(path, "--color/--camera", "no --color or --camera with a BOP image (only --depth)");
     }
+    if (spec.depth_scale) CheckDepthScale(*spec.depth_scale, "--depth-scale");
     LoadedFrame loaded = LoadBopFrame(scene_dir, image_id, spec.depth_path);
     if (spec.depth_scale) {
-      const std::string depth = spec.depth_path.empty() ? path : spec.depth_path;
+      const std::string depth = BopFrameFiles(scene_dir, image_id, spec.depth_path).at(2);  // the depth image read
       loaded.rgbd.depth = ReadDepthImage(depth, *spec.depth_scale);
     }
     loaded.rgbd.Check();
@@ -230,8 +226,11 @@ LoadedFrame LoadFrame(const FrameSpec& spec, std::vector<std::string>* warnings)
       ThrowInputError("frame", "--color/--depth/--depth-scale/--camera",
                       std::string("all four flags, or one positional FRAME: ") + kFrameForms);
     }
-    loaded.rgbd = MakeFrame(spec.color_path, spec.depth_path, *spec.depth_scale,
-                            ParseIntrinsics(*spec.camera, "--camera"), spec.color_path);
+    // The flags' values are named by the flags, before an image is read.
+    const std::array<double, 4> intrinsics = ParseIntrinsics(*spec.camera, "--camera");
+    CheckDepthScale(*spec.depth_scale, "--depth-scale");
+    CheckIntrinsics(intrinsics, "--camera", "fx,fy,cx,cy");
+    loaded.rgbd = MakeFrame(spec.color_path, spec.depth_path, *spec.depth_scale, intrinsics, spec.color_path);
   }
   if (warnings != nullptr) {
     if (std::optional<std::string> warning = DepthRangeWarning(loaded.rgbd.depth, depth_source)) {
@@ -255,10 +254,7 @@ std::optional<std::string> DepthRangeWarning(const cv::Mat& depth_m, const std::
 }
 
 cv::Mat ReadColorImage(const std::string& path) {
-  RequireFile(path, "colour image");
-  const cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
-  if (image.empty()) ThrowInputError(path, "colour image", "a PNG or JPG image", "an unreadable file");
-  return ColorImageAsRgb(image, path);
+  return ColorImageAsRgb(ReadImageFile(path, "colour image"), path);
 }
 
 void WriteColorImage(const std::string& path, const cv::Mat& image) {
@@ -280,10 +276,7 @@ void WriteColorImage(const std::string& path, const cv::Mat& image) {
 
 cv::Mat ReadDepthImage(const std::string& path, double depth_scale) {
   CheckDepthScale(depth_scale, path);
-  RequireFile(path, "depth image");
-  const cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
-  if (image.empty()) ThrowInputError(path, "depth image", "a 16-bit single-channel PNG", "an unreadable file");
-  return DepthImageAsMetres(image, depth_scale, path);
+  return DepthImageAsMetres(ReadImageFile(path, "depth image"), depth_scale, path);
 }
 
 std::array<double, 4> ParseIntrinsics(const std::string& text, const std::string& source) {
@@ -338,9 +331,12 @@ LoadedFrame LoadFrameJson(const std::string& path) {
     if (!value.is_number()) ThrowInputError(path, "camera", "an array [fx, fy, cx, cy] of 4 numbers in pixels");
     intrinsics[i] = value.get<double>();
   }
+  // The values the JSON holds are its errors, before an image is read.
+  const double depth_scale = json["depth_scale"].get<double>();
+  CheckDepthScale(depth_scale, path);
+  CheckIntrinsics(intrinsics, path, "camera");
   LoadedFrame loaded;
-  loaded.rgbd =
-      MakeFrame(string_field("color"), string_field("depth"), json["depth_scale"].get<double>(), intrinsics, path);
+  loaded.rgbd = MakeFrame(string_field("color"), string_field("depth"), depth_scale, intrinsics, path);
   for (auto [key, id] : {std::pair{"scene_id", &loaded.scene_id}, std::pair{"image_id", &loaded.image_id}}) {
     if (!json.contains(key)) continue;
     if (!json[key].is_number_integer() || json[key].get<int64_t>() < 0 || json[key].get<int64_t>() > 999999999) {

@@ -2,12 +2,15 @@
 
 #include <cmath>
 #include <cstdint>
+#include <sstream>
 #include <vector>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
+#include "io/files.h"
+#include "io/image_header.h"
 
 namespace ecv {
 namespace {
@@ -28,34 +31,38 @@ int Base64Digit(char c) {
   return -1;
 }
 
-uint32_t BigEndian32(const std::string& bytes, size_t at) {
-  uint32_t value = 0;
-  for (size_t i = 0; i < 4; ++i) value = (value << 8) | static_cast<unsigned char>(bytes[at + i]);
-  return value;
-}
-
-// The PNG in `bytes`, decoded as it is stored, after its header (signature and IHDR chunk: width and height, big
-// endian, at bytes 16 and 20) has been checked against kMaxDecodedSide.
-cv::Mat DecodePng(const std::string& bytes, const std::string& source, const char* what) {
-  static const std::string kSignature = "\x89PNG\r\n\x1a\n";
-  if (bytes.size() < 24 || bytes.compare(0, 8, kSignature) != 0 || bytes.compare(12, 4, "IHDR") != 0) {
-    ThrowInputError(source, what, "a PNG file", "no PNG header");
+// `bytes` decoded with `flags` once `header` (theirs) has been checked against the bounds.
+cv::Mat DecodeChecked(const std::string& bytes, const ImageHeader& header, const std::string& source,
+                      const std::string& what, int flags) {
+  const uint64_t bound = kMaxDecodedSide;
+  const std::string format = ToString(header.format);
+  if (header.width < 1 || header.height < 1 || header.width > bound || header.height > bound) {
+    ThrowInputError(source, what, "a " + format + " of 1 to " + std::to_string(bound) + " pixels a side",
+                    std::to_string(header.width) + " x " + std::to_string(header.height));
   }
-  const uint32_t width = BigEndian32(bytes, 16), height = BigEndian32(bytes, 20);
-  const uint32_t bound = kMaxDecodedSide;
-  if (width < 1 || height < 1 || width > bound || height > bound) {
-    ThrowInputError(source, what, "a PNG of 1 to " + std::to_string(bound) + " pixels a side",
-                    std::to_string(width) + " x " + std::to_string(height));
+  const uint64_t decoded = header.width * header.height * static_cast<uint64_t>(header.bytes_per_pixel);
+  if (decoded > kMaxDecodedBytes) {
+    ThrowInputError(source, what,
+                    "a " + format + " of at most " + std::to_string(kMaxDecodedBytes >> 20) + " MB decoded",
+                    std::to_string(header.width) + " x " + std::to_string(header.height) + " pixels of " +
+                        std::to_string(header.bytes_per_pixel) + " bytes");
   }
   cv::Mat image;
   try {
-    image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U, const_cast<char*>(bytes.data())),
-                         cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception&) {
+    image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U, const_cast<char*>(bytes.data())), flags);
+  } catch (const cv::Exception& error) {
+    if (error.code == cv::Error::StsNoMem) throw;  // out of memory, not bad bytes: the command names it
     image.release();
   }
-  if (image.empty()) ThrowInputError(source, what, "a PNG file", "bytes that do not decode");
+  if (image.empty()) ThrowInputError(source, what, "a " + format + " file", "bytes that do not decode");
   return image;
+}
+
+// The PNG in `bytes`, decoded as it is stored, after its header has been checked.
+cv::Mat DecodePng(const std::string& bytes, const std::string& source, const char* what) {
+  const ImageHeader header = ReadImageHeader(bytes);
+  if (header.format != ImageFormat::kPng) ThrowInputError(source, what, "a PNG file", "no PNG header");
+  return DecodeChecked(bytes, header, source, what, cv::IMREAD_UNCHANGED);
 }
 
 }  // namespace
@@ -95,11 +102,32 @@ cv::Mat ColorImageAsRgb(const cv::Mat& decoded, const std::string& source) {
   return rgb;
 }
 
-void CheckDepthScale(double depth_scale, const std::string& source) {
-  if (!std::isfinite(depth_scale) || depth_scale <= 0.0) {
-    ThrowInputError(source, "depth_scale", "a finite positive scale (metres = value / scale)",
-                    std::to_string(depth_scale));
+cv::Mat DecodeImage(const std::string& bytes, const std::string& source, const std::string& what, int flags) {
+  const ImageHeader header = ReadImageHeader(bytes);
+  if (header.format == ImageFormat::kUnknown) {
+    ThrowInputError(source, what, "a PNG, JPG or TIFF image", bytes.empty() ? "an empty file" : "no such header");
   }
+  return DecodeChecked(bytes, header, source, what, flags);
+}
+
+cv::Mat ReadImageFile(const std::string& path, const std::string& what, int flags) {
+  return DecodeImage(ReadFileBytes(path, what, kMaxImageFileBytes), path, what, flags);
+}
+
+void CheckDepthScale(double depth_scale, const std::string& source, const std::string& field) {
+  if (!std::isfinite(depth_scale) || depth_scale <= 0.0) {
+    std::ostringstream given;
+    given << depth_scale;
+    ThrowInputError(source, field, "a finite positive scale (metres = value / scale)", given.str());
+  }
+}
+
+void CheckIntrinsics(const std::array<double, 4>& intrinsics, const std::string& source, const std::string& field) {
+  const auto [fx, fy, cx, cy] = intrinsics;
+  if (std::isfinite(fx) && fx > 0.0 && std::isfinite(fy) && fy > 0.0 && std::isfinite(cx) && std::isfinite(cy)) return;
+  std::ostringstream given;
+  given << "fx " << fx << ", fy " << fy << ", cx " << cx << ", cy " << cy;
+  ThrowInputError(source, field, "fx and fy finite and positive, cx and cy finite (pixels)", given.str());
 }
 
 cv::Mat DepthImageAsMetres(const cv::Mat& decoded, double depth_scale, const std::string& source) {
@@ -125,9 +153,9 @@ RgbdFrame FrameOfImages(const cv::Mat& color, const cv::Mat& depth, const std::a
                         const std::string& color_source, const std::string& depth_source, const std::string& name) {
   if (color.size() != depth.size()) {
     ThrowInputError(
-        depth_source, "depth image size",
-        std::to_string(color.cols) + "x" + std::to_string(color.rows) + " as the colour image " + color_source,
-        std::to_string(depth.cols) + "x" + std::to_string(depth.rows));
+        name, "depth image size",
+        std::to_string(color.cols) + "x" + std::to_string(color.rows) + " as the colour image (" + color_source + ")",
+        std::to_string(depth.cols) + "x" + std::to_string(depth.rows) + " (" + depth_source + ")");
   }
   RgbdFrame frame;
   frame.name = name;

@@ -7,13 +7,13 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
-#include <fstream>
 #include <utility>
 #include <vector>
 
 #include <zlib.h>
 
 #include "core/error.h"
+#include "io/files.h"
 
 namespace ecv {
 namespace {
@@ -165,18 +165,9 @@ void CheckMatFileStructure(const unsigned char* data, size_t size, const std::st
 }
 
 void CheckMatFile(const std::string& path) {
-  std::ifstream file(path, std::ios::binary | std::ios::ate);
-  if (!file) ThrowInputError(path, "meta", "a readable MAT-file");
-  const std::streamoff size = file.tellg();
-  constexpr std::streamoff kMaxBytes = std::streamoff{256} << 20;
-  if (size < 0 || size > kMaxBytes) {
-    ThrowInputError(path, "size", "at most 256 MB (a YCB-Video meta file holds a few)",
-                    std::to_string(size) + " bytes");
-  }
-  std::vector<unsigned char> bytes(static_cast<size_t>(size));
-  file.seekg(0);
-  if (!file.read(reinterpret_cast<char*>(bytes.data()), size)) ThrowInputError(path, "meta", "a readable MAT-file");
-  CheckMatFileStructure(bytes.data(), bytes.size(), path);
+  constexpr size_t kMaxBytes = size_t{256} << 20;  // a YCB-Video meta file holds a few KB
+  const std::string bytes = ReadFileBytes(path, "meta", kMaxBytes);
+  CheckMatFileStructure(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(), path);
 }
 
 }  // namespace ecv

@@ -12,7 +12,7 @@ namespace ecv {
 /// naming `path` and what is wrong.
 void CheckMatFileStructure(const unsigned char* data, size_t size, const std::string& path);
 
-/// The same for the file at `path`, read whole (at most 256 MB).
+/// The same for the file at `path`, read whole: a regular file of at most 256 MB (InputError naming it otherwise).
 void CheckMatFile(const std::string& path);
 
 }  // namespace ecv

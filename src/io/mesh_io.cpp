@@ -33,6 +33,8 @@
 #include "core/pose.h"
 #include "io/files.h"
 #include "io/frame_io.h"
+#include "io/glb_check.h"
+#include "io/image_bytes.h"
 #include "io/mesh_blob.h"
 #include "io/ply_check.h"
 
@@ -53,12 +55,13 @@ std::string Trim(const std::string& text) {
   return first == std::string::npos ? "" : text.substr(first, last - first + 1);
 }
 
-// An embedded texture ("*N" or a name matching one of the scene's textures) as RGB.
-cv::Mat DecodeEmbedded(const aiTexture& texture) {
+// An embedded texture ("*N" or a name matching one of the scene's textures) as RGB; compressed ones are checked as
+// image files are (DecodeImage: their header's size first), named `source`.
+cv::Mat DecodeEmbedded(const aiTexture& texture, const std::string& source) {
   cv::Mat bgr;
   if (texture.mHeight == 0) {  // compressed bytes (PNG, JPG) of length mWidth
-    const cv::Mat bytes(1, static_cast<int>(texture.mWidth), CV_8UC1, texture.pcData);
-    bgr = cv::imdecode(bytes, cv::IMREAD_COLOR);
+    const std::string bytes(reinterpret_cast<const char*>(texture.pcData), texture.mWidth);
+    bgr = DecodeImage(bytes, source, "embedded texture", cv::IMREAD_COLOR);
   } else {  // raw aiTexel (b, g, r, a) rows
     const cv::Mat bgra(static_cast<int>(texture.mHeight), static_cast<int>(texture.mWidth), CV_8UC4, texture.pcData);
     cv::cvtColor(bgra, bgr, cv::COLOR_BGRA2BGR);
@@ -87,7 +90,7 @@ void LoadTexture(const fs::path& mesh_dir, const std::string& mesh_path, const M
     material->texture_path.clear();
     return;
   }
-  material->texture = ReadColorImage(file.string());
+  material->texture = ColorImageAsRgb(ReadImageFile(file.string(), "texture"), file.string());
 }
 
 MeshMaterial ConvertMaterial(const aiMaterial& source) {
@@ -153,7 +156,7 @@ TriangleMesh ImportMesh(const std::string& path) {
     MeshMaterial& material = mesh.materials.emplace_back(ConvertMaterial(*scene->mMaterials[i]));
     if (material.texture_path.empty()) continue;
     if (const aiTexture* embedded = scene->GetEmbeddedTexture(material.texture_path.c_str())) {
-      material.texture = DecodeEmbedded(*embedded);
+      material.texture = DecodeEmbedded(*embedded, path + ": " + material.texture_path);
       if (material.texture.empty()) {
         ThrowInputError(path, "embedded texture " + material.texture_path, "a decodable image");
       }
@@ -318,7 +321,11 @@ void CheckObjMaterials(const std::string& path, const MeshLoadOptions& options, 
     std::getline(words >> std::ws, library);
     library = Trim(library);
     const fs::path file = fs::path(path).parent_path() / library;
-    if (library.empty() || PathExists(file)) continue;
+    if (library.empty()) continue;
+    if (PathExists(file)) {
+      RequireRegularFile(file.string(), "material library");  // the importer would wait on a FIFO
+      continue;
+    }
     const std::string message = path + ": material library '" + library + "' not found at " + file.string();
     if (!options.allow_missing_textures) {
       throw InputError(message + " (give --allow-missing-textures to build it with default colours)");
@@ -361,6 +368,7 @@ double MetresPerUnit(const std::string& unit) {
 }
 
 std::map<std::string, Eigen::Isometry3d> ReadTransformTable(const std::string& path) {
+  RequireRegularFile(path, "transform table");
   std::ifstream stream(path);
   if (!stream) ThrowInputError(path, "transform table", "a readable file");
   std::map<std::string, Eigen::Isometry3d> table;
@@ -388,9 +396,9 @@ bool LooksLikeMesh(const std::string& path) {
 
 TriangleMesh LoadMesh(const std::string& path, const MeshLoadOptions& options, std::vector<std::string>* warnings) {
   options.Check();
-  if (!PathExists(path)) ThrowInputError(path, "mesh", "an existing file", "no such file");
-  if (IsDirectory(path)) ThrowInputError(path, "mesh", "a mesh file", "a directory");
+  RequireRegularFile(path, "mesh");  // a FIFO would hang the reader, a link to /dev/zero feed it without end
   const std::string extension = Lowercase(fs::path(path).extension().string());
+  CheckGlbFile(path);
   if (extension == ".ply") CheckPlyFile(path);
   if (extension == ".obj") CheckObjMaterials(path, options, warnings);
 

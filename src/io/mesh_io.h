@@ -29,7 +29,8 @@ struct MeshLoadOptions {
 double MetresPerUnit(const std::string& unit);
 
 /// Loads OBJ (+MTL and texture images), PLY (vertex colours), glTF/GLB and the other formats assimp
-/// reads. PLY files are checked first (CheckPlyFile), and assimp reads the file in a process of its own (the program
+/// reads. The file must be a regular one; PLY and GLB files are checked first (CheckPlyFile, CheckGlbFile), texture
+/// images by their header's size (ReadImageFile), and assimp reads the file in a process of its own (the program
 /// ecvpose-mesh-import, found beside the ecvpose libraries or at $ECVPOSE_MESH_IMPORTER), so that a crash, an
 /// exception or a hang of it becomes an error naming the file. Safe to call from several threads at once. Throws
 /// InputError for a missing, malformed or unreadable file, a mesh without triangles or with non-finite vertices, or a

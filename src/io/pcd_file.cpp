@@ -15,6 +15,7 @@
 #include <system_error>
 
 #include "core/error.h"
+#include "io/files.h"
 
 namespace ecv {
 namespace {
@@ -171,6 +172,7 @@ const PcdField* PcdLayout::Find(const std::string& name) const {
 }
 
 PcdLayout CheckPcdFile(const std::string& path) {
+  RequireRegularFile(path, "PCD");
   std::error_code error;
   const uint64_t file_bytes = std::filesystem::file_size(path, error);
   if (error) ThrowInputError(path, "PCD", "a readable file", error.message());

@@ -7,13 +7,12 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
-#include <iterator>
 #include <limits>
 #include <sstream>
 #include <vector>
 
 #include "core/error.h"
+#include "io/files.h"
 
 namespace ecv {
 namespace {
@@ -177,9 +176,8 @@ PlyFormat ReadHeader(const std::string& path, const std::string& bytes, std::vec
 }  // namespace
 
 void CheckPlyFile(const std::string& path) {
-  std::ifstream stream(path, std::ios::binary);
-  if (!stream) ThrowInputError(path, "PLY", "a readable file");
-  std::string bytes((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>());
+  constexpr size_t kMaxBytes = size_t{1} << 30;  // 1 GB: tens of millions of triangles, more than any model renders
+  std::string bytes = ReadFileBytes(path, "PLY", kMaxBytes);
   std::vector<PlyElement> elements;
   size_t body = 0;
   const PlyFormat format = ReadHeader(path, bytes, &elements, &body);

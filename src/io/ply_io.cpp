@@ -9,6 +9,7 @@
 
 #include "core/error.h"
 #include "io/atomic_file.h"
+#include "io/files.h"
 
 namespace ecv {
 namespace {
@@ -46,6 +47,7 @@ void WritePrimitivesPly(const std::string& path, const std::vector<Primitive>& p
 }
 
 std::vector<Primitive> ReadPrimitivesPly(const std::string& path) {
+  RequireRegularFile(path, "PLY");
   std::ifstream stream(path, std::ios::binary);
   if (!stream) ThrowInputError(path, "PLY", "a readable file");
   std::string line;
@@ -59,6 +61,15 @@ std::vector<Primitive> ReadPrimitivesPly(const std::string& path) {
     if (keyword == "element" && second == "vertex") fields >> count;
   }
   if (!binary || line != kHeaderEnd) ThrowInputError(path, "header", "a binary PLY written by ecvpose");
+  // The count against the bytes that follow, before anything is allocated for it.
+  const std::streamoff body = stream.tellg();
+  stream.seekg(0, std::ios::end);
+  const std::streamoff records = (stream.tellg() - body) / static_cast<std::streamoff>(kRecordSize);
+  stream.seekg(body);
+  if (static_cast<std::streamoff>(count) > records) {
+    ThrowInputError(path, "element vertex", std::to_string(records) + " vertices (the records that follow)",
+                    std::to_string(count));
+  }
   std::vector<Primitive> primitives(count);
   for (Primitive& primitive : primitives) {
     char record[kRecordSize];

@@ -10,7 +10,7 @@
 namespace ecv {
 
 std::vector<Eigen::Vector3d> ReadXyzFile(const std::string& path, double metres_per_unit) {
-  if (!PathExists(path)) ThrowInputError(path, "points", "an existing file", "no such file");
+  RequireRegularFile(path, "points");
   std::ifstream stream(path);
   std::vector<Eigen::Vector3d> points;
   std::string line;

@@ -1,7 +1,6 @@
 #include "io/pose_io.h"
 
 #include <filesystem>
-#include <fstream>
 
 #include "core/error.h"
 #include "core/pose.h"
@@ -44,11 +43,11 @@ void WritePoseFile(const std::string& path, const std::map<std::string, Eigen::I
 }
 
 nlohmann::json ReadJsonFile(const std::string& path) {
-  if (!PathExists(path)) ThrowInputError(path, "JSON file", "an existing file", "no such file");
-  std::ifstream stream(path);
-  if (!stream) ThrowInputError(path, "JSON file", "a readable file");
+  // A regular file of at most 256 MB: BOP's largest scene_gt.json files hold a few.
+  constexpr size_t kMaxBytes = size_t{256} << 20;
+  const std::string text = ReadFileBytes(path, "JSON file", kMaxBytes);
   try {
-    return nlohmann::json::parse(stream);
+    return nlohmann::json::parse(text);
   } catch (const nlohmann::json::exception& error) {
     // error.what() gives "[json.exception.parse_error.101] parse error at line L, column C: ..." (or a number out of
     // range: out_of_range.406).

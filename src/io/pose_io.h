@@ -24,7 +24,8 @@ Eigen::Isometry3d ReadPoseFile(const std::string& path, const std::string& key =
 /// Writes the named poses to `path` (written to a temporary file first, then renamed).
 void WritePoseFile(const std::string& path, const std::map<std::string, Eigen::Isometry3d>& poses);
 
-/// Parses a JSON file, throwing InputError with the file, line and column on malformed text.
+/// Parses a JSON file (a regular file of at most 256 MB), throwing InputError naming the file when it is none, and
+/// with the line and column on malformed text.
 nlohmann::json ReadJsonFile(const std::string& path);
 
 /// Writes `value` to `path` atomically (temporary file, then rename); throws InputError if it cannot.

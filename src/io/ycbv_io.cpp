@@ -9,10 +9,10 @@
 #include <vector>
 
 #include <matio.h>
-#include <opencv2/imgcodecs.hpp>
 
 #include "core/error.h"
 #include "io/frame_io.h"
+#include "io/image_bytes.h"
 #include "io/mat_check.h"
 
 namespace ecv {
@@ -124,9 +124,12 @@ LoadedFrame LoadYcbvFrame(const std::string& prefix) {
 
   // Column-major: element (r, c) of a 3x3 is values[r + 3 c]; of pose n, values[r + 3 c + 12 n].
   const std::vector<double>& k = intrinsics.values;
+  const std::array<double, 4> camera = {k[0], k[4], k[6], k[7]};
+  // The meta file's values are its errors, before an image is read.
+  CheckDepthScale(factor.values[0], meta_path, "factor_depth");
+  CheckIntrinsics(camera, meta_path, "intrinsic_matrix");
   LoadedFrame loaded;
-  loaded.rgbd =
-      MakeFrame(prefix + "-color.png", prefix + "-depth.png", factor.values[0], {k[0], k[4], k[6], k[7]}, prefix);
+  loaded.rgbd = MakeFrame(prefix + "-color.png", prefix + "-depth.png", factor.values[0], camera, prefix);
   const std::filesystem::path name(prefix);
   loaded.scene_id = NumberOfName(name.parent_path().filename().string());
   loaded.image_id = loaded.scene_id >= 0 ? NumberOfName(name.filename().string()) : -1;
@@ -162,9 +165,8 @@ LoadedFrame PasteYcbvObject(LoadedFrame frame, const std::string& source_prefix,
                                   [&](const GroundTruth& g) { return g.object_name == object_name; });
   if (truth == source.ground_truth.end()) ThrowInputError(source_prefix + "-meta.mat", "cls_indexes", object_name);
   const std::string label_path = source_prefix + "-label.png";
-  const cv::Mat labels = cv::imread(label_path, cv::IMREAD_UNCHANGED);
-  if (labels.empty() || labels.size() != source.rgbd.depth.size() || labels.depth() != CV_8U ||
-      labels.channels() != 1) {
+  const cv::Mat labels = ReadImageFile(label_path, "label");
+  if (labels.size() != source.rgbd.depth.size() || labels.depth() != CV_8U || labels.channels() != 1) {
     ThrowInputError(label_path, "label", "an 8-bit one-channel PNG of the frame's size");
   }
   const cv::Mat object = labels == truth->object_id;

@@ -45,9 +45,14 @@ TEST(FeaturesCli, WritesOverlayPlyAndCounts) {
 
 TEST(FeaturesCli, BadOptionsAreUsageOrInputErrors) {
   const std::string frame = test::DataPath("ycbv_subset/Example-Scenes/0001/000001");
-  const test::CommandResult tiny_wavelength = test::RunCli("features " + frame + " --wavelength 1");
-  EXPECT_EQ(tiny_wavelength.exit_code, 1);
-  EXPECT_THAT(tiny_wavelength.output, HasSubstr("wavelength_px"));
+  // A wavelength out of range is a usage error naming the flag and its range, before the frame is read (1e9 asked
+  // OpenCV for 16 EB of padding).
+  for (const std::string wavelength : {"1", "1e9"}) {
+    const test::CommandResult result = test::RunCli("features " + frame + " --wavelength " + wavelength);
+    EXPECT_EQ(result.exit_code, 2) << result.output;
+    EXPECT_THAT(result.output,
+                HasSubstr("--wavelength: expected a number above 2 and at most 1024, got " + wavelength));
+  }
   EXPECT_EQ(test::RunCli("features " + frame + " --spacing abc").exit_code, 2);
   EXPECT_EQ(test::RunCli("features /nonexistent/0001/000001").exit_code, 1);
 }

@@ -10,6 +10,7 @@
 #include "io/frame_io.h"
 #include "io/mesh_io.h"
 #include "io/pose_io.h"
+#include "support/input_error.h"
 #include "support/test_data.h"
 
 namespace ecv {
@@ -18,17 +19,7 @@ namespace {
 using ::testing::AllOf;
 using ::testing::HasSubstr;
 
-// The message of the InputError that `action` throws, or a failure if it throws none.
-template <typename Action>
-std::string InputErrorMessage(Action action) {
-  try {
-    action();
-  } catch (const InputError& error) {
-    return error.what();
-  }
-  ADD_FAILURE() << "expected an InputError";
-  return "";
-}
+using test::InputErrorMessage;
 
 class BadInput : public ::testing::Test {
  protected:

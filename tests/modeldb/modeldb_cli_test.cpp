@@ -228,6 +228,32 @@ TEST_F(ModeldbCli, ReportsABadMeshInADirectoryAndBuildsTheRest) {
   EXPECT_EQ(models[0].name, "006_mustard_bottle");
 }
 
+// A texture whose PNG header claims 60000 x 60000 pixels (decoding it stopped the whole build with an OpenCV
+// assertion that named no file) is reported by name before it is decoded, and the other meshes are built; exit 1.
+TEST_F(ModeldbCli, ATextureOfAnImpossibleSizeIsReportedAndTheRestBuilt) {
+  const fs::path meshes = scratch_.path() / "meshes";
+  LinkModels(meshes, {kModels[1]});
+  const fs::path folder = meshes / "000_huge_texture";  // first in name order: the build goes on after it
+  fs::create_directories(folder);
+  std::ofstream(folder / "000_huge_texture.obj") << "mtllib skin.mtl\nv 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nvt 0 0\nvt 1 0\n"
+                                                    "vt 0 1\nusemtl skin\nf 1/1 2/2 3/3\n";
+  std::ofstream(folder / "skin.mtl") << "newmtl skin\nmap_Kd skin.png\n";
+  std::string png = std::string("\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR", 16);
+  for (int side = 0; side < 2; ++side) png += std::string("\0\0\xea\x60", 4);  // 60000, big-endian
+  png += std::string("\x08\x02\0\0\0\0\0\0\0", 9);                             // 8-bit RGB; CRC, data left out
+  std::ofstream(folder / "skin.png", std::ios::binary) << png;
+  const std::string library = scratch_.File("lib.sqlite");
+  const test::CommandResult result =
+      test::RunCli("modeldb build " + meshes.string() + " --db " + library + QuickFlags(1));
+  EXPECT_EQ(result.exit_code, 1) << result.output;
+  EXPECT_THAT(result.output, AllOf(HasSubstr("000_huge_texture: FAILED: " + (folder / "skin.png").string() +
+                                             ": texture: expected a PNG of 1 to 8192 pixels a side, got 60000 x 60000"),
+                                   HasSubstr("built 1 of 2 models"), Not(HasSubstr("OpenCV"))));
+  const std::vector<ModelSummary> models = ModelDatabase(library, OpenMode::kReadOnly).ListModels();
+  ASSERT_EQ(models.size(), 1U);
+  EXPECT_EQ(models[0].name, "006_mustard_bottle");
+}
+
 // The malformed PLYs that crashed the mesh importer: each reported, naming the file, and the rest of the directory
 // built.
 TEST_F(ModeldbCli, MalformedPlysAreReportedAndTheRestBuilt) {

@@ -27,6 +27,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "io/frame_io.h"
 #include "io/image_bytes.h"
 #include "modeldb/model_library.h"
 #include "recognize/recognition_service.h"
@@ -430,6 +431,71 @@ TEST_F(ServeProtocol, ASilentClientHoldsNoOther) {
   EXPECT_EQ(ReadLine(a, 10000), "<end>");
   EXPECT_GE(std::chrono::steady_clock::now() - start, std::chrono::milliseconds(1900));
   for (const int fd : {a, b, c}) close(fd);
+}
+
+// 8 clients at once, each sending 5 frames and 2 bad requests in one write: every line is answered, in order, with its
+// own id (null for a line that is not JSON), while the recognitions share one queue. The frames are a 160 x 120 crop
+// of the demo frame without its depth (nothing to find: a few milliseconds each), the first client's first one the
+// whole demo frame (its 3 objects found, in half a second).
+TEST_F(ServeProtocol, EightClientsOfFiveFramesAndBadRequestsAreAnsweredWithTheirIds) {
+  namespace fs = std::filesystem;
+  const fs::path root = directory_->path() / "clients";
+  fs::create_directories(root);
+  RgbdFrame crop = LoadYcbvFrame(DemoFrame()).rgbd;
+  const cv::Rect window(240, 160, 160, 120);
+  crop.color = crop.color(window).clone();
+  crop.depth = crop.depth(window).clone();
+  crop.camera.cx -= window.x;
+  crop.camera.cy -= window.y;
+  crop.camera.width = window.width;
+  crop.camera.height = window.height;
+  crop.depth.setTo(0.0F);
+  const std::string small = (root / "crop.json").string();
+  WriteFrameJson(small, crop);
+
+  const std::string socket = directory_->File("eight.sock");
+  const BackgroundServe serve("",
+                              "--db " + library_ + " --socket " + socket + " --threads 2 --root " + root.string() +
+                                  " --root " + fs::path(DemoFrame()).parent_path().string(),
+                              directory_->File("eight.log"));
+  ASSERT_TRUE(serve.WaitForReady());
+  constexpr int kClients = 8, kFrames = 5;
+  std::vector<std::vector<nlohmann::json>> answers(kClients);
+  std::vector<std::thread> clients;
+  for (int c = 0; c < kClients; ++c) {
+    clients.emplace_back([&, c] {
+      const int fd = ConnectTo(socket);
+      if (fd < 0) return;
+      std::string lines;
+      for (int f = 0; f < kFrames; ++f) {
+        const std::string frame = c == 0 && f == 0 ? DemoFrame() : small;
+        lines += nlohmann::json{{"id", std::to_string(c) + "-" + std::to_string(f)}, {"frame", frame}}.dump() + "\n";
+      }
+      lines += "{\"id\": 7, \"frame\": \n";                                                         // not JSON: id null
+      lines += nlohmann::json{{"id", c}, {"frame", "/etc/passwd"}, {"track", true}}.dump() + "\n";  // outside the roots
+      if (write(fd, lines.data(), lines.size()) != static_cast<ssize_t>(lines.size())) return;
+      for (int i = 0; i < kFrames + 2; ++i) {
+        const std::string line = ReadLine(fd, 120000);
+        answers[static_cast<size_t>(c)].push_back(nlohmann::json::parse(line, nullptr, false));
+      }
+      close(fd);
+    });
+  }
+  for (std::thread& client : clients) client.join();
+  for (int c = 0; c < kClients; ++c) {
+    const std::vector<nlohmann::json>& got = answers[static_cast<size_t>(c)];
+    ASSERT_EQ(got.size(), static_cast<size_t>(kFrames + 2)) << "client " << c;
+    for (int f = 0; f < kFrames; ++f) {
+      const nlohmann::json& answer = got[static_cast<size_t>(f)];
+      EXPECT_EQ(answer.value("id", ""), std::to_string(c) + "-" + std::to_string(f)) << answer.dump().substr(0, 300);
+      EXPECT_TRUE(answer.contains("detections")) << answer.dump().substr(0, 300);
+    }
+    EXPECT_TRUE(got[kFrames].at("id").is_null());
+    EXPECT_NE(got[kFrames].value("error", "").find("one JSON object per line"), std::string::npos);
+    EXPECT_EQ(got[kFrames + 1].at("id"), c);
+    EXPECT_EQ(got[kFrames + 1].value("error", ""), "frame: not readable here: /etc/passwd");
+  }
+  EXPECT_EQ(answers[0][0].at("detections").size(), 3U) << answers[0][0].dump().substr(0, 300);
 }
 
 }  // namespace

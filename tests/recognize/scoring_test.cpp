@@ -266,6 +266,71 @@ TEST(OutlineOnDepthSteps, IsOneForABoxStandingOutAndZeroForOneLyingFlatOnALarger
   EXPECT_DOUBLE_EQ(OutlineOnDepthSteps(half, 2, scene, steps, 0.015).Share(), 1.0);
 }
 
+TEST(SurfaceContinuation, IsZeroForABoxStandingOutAndOneForABoxLaidOnALargerFace) {
+  const cv::Rect box(20, 20, 20, 20);
+  const cv::Mat scene = TableWithBox(box);
+  const OutlineContinuation standing = SurfaceContinuation(Rendered(box), 1, scene, 0.015);
+  EXPECT_EQ(standing.tested, 76);  // every outline pixel: the face is one plane, the table 4 cm behind
+  EXPECT_EQ(standing.continued, 0);
+  cv::Mat half;
+  cv::resize(Rendered(box), half, cv::Size(40, 30), 0.0, 0.0, cv::INTER_NEAREST);
+  EXPECT_DOUBLE_EQ(SurfaceContinuation(half, 2, scene, 0.015).Share(), 0.0);  // sampled every 2nd pixel, the same
+  // A smaller box laid on a big box's face, 20 pixels from its edges: the face runs on beyond its whole outline.
+  const cv::Rect big(10, 10, 60, 40), small(30, 30, 20, 10);
+  const cv::Mat face = TableWithBox(big);
+  const OutlineContinuation laid = SurfaceContinuation(Rendered(small), 1, face, 0.015);
+  EXPECT_EQ(laid.tested, 56);
+  EXPECT_DOUBLE_EQ(laid.Share(), 1.0);
+  cv::resize(Rendered(small), half, cv::Size(40, 30), 0.0, 0.0, cv::INTER_NEAREST);
+  EXPECT_DOUBLE_EQ(SurfaceContinuation(half, 2, face, 0.015).Share(), 1.0);
+  // Near one edge of the face (2 pixels off it), the outline on that side ends with the face.
+  const OutlineContinuation edge = SurfaceContinuation(Rendered(cv::Rect(12, 30, 20, 10)), 1, face, 0.015);
+  EXPECT_GT(edge.Share(), 0.5);
+  EXPECT_LT(edge.Share(), 0.9);
+}
+
+TEST(SurfaceContinuation, TakesACreaseAsAnEndAndLeavesOutCurvesAndHiddenOutline) {
+  // The box's face stands on a table that comes towards the camera below it: no depth step at the contact, but the
+  // table turns away from the face's plane (2 mm per pixel).
+  const cv::Rect box(20, 20, 20, 20);
+  cv::Mat scene = TableWithBox(box);
+  for (int v = 40; v < scene.rows; ++v) scene.row(v).setTo(0.96F - 0.002F * static_cast<float>(v - 39));
+  const OutlineContinuation crease = SurfaceContinuation(Rendered(box), 1, scene, 0.015);
+  EXPECT_EQ(crease.tested, 76);
+  EXPECT_EQ(crease.continued, 0);
+  // Within 4 mm of the face's plane the table would run on from it: 0.25 mm per pixel.
+  for (int v = 40; v < scene.rows; ++v) scene.row(v).setTo(0.96F - 0.00025F * static_cast<float>(v - 39));
+  const OutlineContinuation shallow = SurfaceContinuation(Rendered(box), 1, scene, 0.015);
+  EXPECT_GE(shallow.continued, 20);  // the bottom row ...
+  EXPECT_LE(shallow.continued, 30);  // ... and the lowest 5 of each side column, whose band reaches below the box
+  // A face that is not one plane under the window decides nothing: a 5 mm ridge in every other column.
+  cv::Mat ridged = TableWithBox(box);
+  for (int u = box.x; u < box.x + box.width; u += 2) ridged(cv::Rect(u, box.y, 1, box.height)) -= 0.005F;
+  EXPECT_EQ(SurfaceContinuation(Rendered(box), 1, ridged, 0.015).tested, 0);
+  // Hidden outline (something 10 cm in front of all of it) is not judged.
+  cv::Mat hidden(scene.size(), CV_32FC1, cv::Scalar(0.86F));
+  EXPECT_EQ(SurfaceContinuation(Rendered(box), 1, hidden, 0.015).tested, 0);
+}
+
+TEST(SurfaceContinuation, RejectsImagesThatDoNotFitAndBadOptions) {
+  const cv::Mat scene = TableWithBox(cv::Rect(20, 20, 20, 20));
+  EXPECT_THROW(SurfaceContinuation(Rendered(cv::Rect(20, 20, 20, 20)), 2, scene, 0.015), InputError);
+  cv::Mat millimetres;
+  scene.convertTo(millimetres, CV_16UC1, 1000.0);
+  EXPECT_THROW(SurfaceContinuation(Rendered(cv::Rect(20, 20, 20, 20)), 1, millimetres, 0.015), InputError);
+  ContinuationOptions options;
+  options.max_gap_px = options.window_px + 1;
+  EXPECT_THROW(SurfaceContinuation(Rendered(cv::Rect(20, 20, 20, 20)), 1, scene, 0.015, options), InputError);
+}
+
+TEST(ContinuationFactor, FallsFromFreeOverFalloffAndIsOneWhenTooFewAreJudged) {
+  EXPECT_DOUBLE_EQ(ContinuationFactor({100, 20}, 0.25, 0.25, 20), 1.0);
+  EXPECT_DOUBLE_EQ(ContinuationFactor({100, 40}, 0.25, 0.25, 20), 1.0 - 0.15 / 0.25);
+  EXPECT_DOUBLE_EQ(ContinuationFactor({100, 60}, 0.25, 0.25, 20), 0.0);
+  EXPECT_DOUBLE_EQ(ContinuationFactor({10, 10}, 0.25, 0.25, 20), 1.0);   // too few judged
+  EXPECT_DOUBLE_EQ(ContinuationFactor({100, 100}, 0.25, 0.0, 20), 1.0);  // no factor
+}
+
 TEST(OutlineOnDepthSteps, LeavesOutHiddenOutlineAndTheImageBorder) {
   const cv::Rect box(20, 20, 20, 20);
   cv::Mat scene = TableWithBox(box);

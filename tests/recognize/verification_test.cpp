@@ -66,7 +66,7 @@ TEST(MeasurePose, TheRightPoseLiesOnTheSurfaceCorrelatesAndHasItsOutlineOnTheBox
   EXPECT_EQ(evidence.outline.on_step, evidence.outline.seen);
 
   Detection detection;
-  ScorePose(evidence, options, &detection);
+  ScorePose(evidence, options, false, &detection);
   EXPECT_DOUBLE_EQ(detection.depth_agreement, 1.0);
   EXPECT_DOUBLE_EQ(detection.visible_fraction, 1.0);
   EXPECT_DOUBLE_EQ(detection.contour_agreement, 1.0);
@@ -87,7 +87,7 @@ TEST(MeasurePose, TheRightSurfaceWithTheWrongPrintScoresLow) {
   }
   Detection detection;
   ScorePose(MeasurePose(rendered, MakeVerificationFrame(frame, options, kStride), Eigen::Matrix3f::Identity(), options),
-            options, &detection);
+            options, false, &detection);
   EXPECT_DOUBLE_EQ(detection.depth_agreement, 1.0);
   EXPECT_LT(detection.color_agreement, 0.1);
   EXPECT_LT(detection.score, 0.1);
@@ -100,9 +100,9 @@ TEST(MeasurePose, APoseFiveMillimetresOffScoresHalfThroughTheFitFactor) {
   const VerifyOptions options;
   const VerificationFrame verification = MakeVerificationFrame(frame, options, kStride);
   Detection right, off;
-  ScorePose(MeasurePose(BoxRender(0.0F), verification, Eigen::Matrix3f::Identity(), options), options, &right);
+  ScorePose(MeasurePose(BoxRender(0.0F), verification, Eigen::Matrix3f::Identity(), options), options, false, &right);
   const PoseEvidence evidence = MeasurePose(BoxRender(0.005F), verification, Eigen::Matrix3f::Identity(), options);
-  ScorePose(evidence, options, &off);
+  ScorePose(evidence, options, false, &off);
   EXPECT_NEAR(evidence.surface_error_m, 0.005, 1e-6);
   EXPECT_DOUBLE_EQ(off.depth_agreement, right.depth_agreement);
   EXPECT_NEAR(off.score, 0.5 * right.score, 1e-5);
@@ -119,7 +119,7 @@ TEST(MeasurePose, ASurfaceInFrontHidesPixelsWithoutCountingAgainstThePose) {
                                             Eigen::Matrix3f::Identity(), options);
   EXPECT_EQ(evidence.visible, evidence.rendered_pixels / 2);
   Detection detection;
-  ScorePose(evidence, options, &detection);
+  ScorePose(evidence, options, false, &detection);
   EXPECT_DOUBLE_EQ(detection.visible_fraction, 0.5);
   EXPECT_DOUBLE_EQ(detection.depth_agreement, 1.0);
 }
@@ -144,7 +144,7 @@ TEST(ScorePose, MultipliesTheTermsAsDocumented) {
   evidence.edges = {100, 36};    // predicted, shown: 0.64^0.5 x 0.36^0.5 = 0.48
   evidence.outline = {100, 50};  // seen, on a step: 0.5 >= contour_free, factor 1
   Detection detection;
-  ScorePose(evidence, options, &detection);
+  ScorePose(evidence, options, false, &detection);
   EXPECT_DOUBLE_EQ(detection.visible_fraction, 0.8);
   EXPECT_DOUBLE_EQ(detection.depth_agreement, 0.75);
   EXPECT_DOUBLE_EQ(detection.edge_agreement, 0.36);
@@ -152,16 +152,16 @@ TEST(ScorePose, MultipliesTheTermsAsDocumented) {
   EXPECT_NEAR(detection.score, 0.75 * 0.48, 1e-12);
 
   evidence.outline = {100, 20};  // 0.2 on a step: 1 - (0.3 - 0.2) / 0.2 = 0.5
-  ScorePose(evidence, options, &detection);
+  ScorePose(evidence, options, false, &detection);
   EXPECT_NEAR(detection.score, 0.75 * 0.48 * 0.5, 1e-12);
 
   options.edge_weight = 0.0;  // colour alone
-  ScorePose(evidence, options, &detection);
+  ScorePose(evidence, options, false, &detection);
   EXPECT_NEAR(detection.score, 0.75 * 0.64 * 0.5, 1e-12);
 
   evidence.edges = {10, 1};  // under min_edge_pixels: colour alone whatever the weight
   options.edge_weight = 0.5;
-  ScorePose(evidence, options, &detection);
+  ScorePose(evidence, options, false, &detection);
   EXPECT_NEAR(detection.score, 0.75 * 0.64 * 0.5, 1e-12);
 }
 

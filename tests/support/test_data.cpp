@@ -1,6 +1,11 @@
 #include "support/test_data.h"
 
+#include <errno.h>
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cstdio>
@@ -36,15 +41,37 @@ CommandResult RunCli(const std::string& arguments, const std::string& prefix) {
 }
 
 CommandResult RunCommand(const std::string& shell_command) {
-  const std::string command = shell_command + " 2>&1";
   CommandResult result;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return result;
+  int fds[2];
+  if (pipe2(fds, O_CLOEXEC) != 0) return result;
+  // posix_spawn and wait4, not popen: the child's rusage covers the shell and every process it waited for.
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, fds[1], STDOUT_FILENO);
+  posix_spawn_file_actions_adddup2(&actions, fds[1], STDERR_FILENO);
+  const char* argv[] = {"sh", "-c", shell_command.c_str(), nullptr};
+  pid_t child = -1;
+  const int failed = posix_spawn(&child, "/bin/sh", &actions, nullptr, const_cast<char* const*>(argv), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  close(fds[1]);
+  if (failed != 0) {
+    close(fds[0]);
+    return result;
+  }
   std::array<char, 4096> buffer{};
-  size_t count = 0;
-  while ((count = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) result.output.append(buffer.data(), count);
-  const int status = pclose(pipe);
+  for (;;) {
+    const ssize_t count = read(fds[0], buffer.data(), buffer.size());
+    if (count < 0 && errno == EINTR) continue;
+    if (count <= 0) break;
+    result.output.append(buffer.data(), static_cast<size_t>(count));
+  }
+  close(fds[0]);
+  int status = 0;
+  rusage usage{};
+  while (wait4(child, &status, 0, &usage) < 0 && errno == EINTR) {
+  }
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  result.peak_rss_kb = usage.ru_maxrss;
   return result;
 }
 

@@ -27,7 +27,8 @@ class TemporaryDirectory {
 /// Output and exit code of a command run through the shell.
 struct CommandResult {
   int exit_code = -1;
-  std::string output;  ///< standard output and standard error together
+  std::string output;     ///< standard output and standard error together
+  long peak_rss_kb = -1;  ///< the largest resident set of the command's processes (getrusage ru_maxrss), KB
 };
 
 /// Runs the ecvpose tool with `arguments` (shell syntax), after `prefix` (e.g. a command that drops
