@@ -48,7 +48,7 @@ struct VerifyOptions {
   /// A model painted in one colour (no texture, one vertex or material colour: a grey CAD mesh) says nothing of the
   /// object's print: its appearance term is this instead, and it is judged by its geometry (0: by its colours, as
   /// any model).
-  double plain_appearance = 0.5;
+  double plain_appearance = 0.0;
   double min_score = 0.3;             ///< poses below are not detections
   double min_visible_fraction = 0.1;  ///< nor poses of which the scene can show less than this share
   /// A pose whose surface is one patch of a larger scene plane scores 0 (PatchOfLargerPlane): the depth shows

@@ -1,6 +1,12 @@
 # Installs ecvpose into a temporary prefix, builds tests/package/consumer against it and runs it on a
 # real frame. Called by ctest with -DSOURCE_DIR -DBUILD_DIR -DDATA_DIR.
 set(work "${BUILD_DIR}/package_consumer")
+# The consumer finds the package with the README's own line.
+file(STRINGS "${SOURCE_DIR}/README.md" readme_line REGEX "^find_package\\(ecvpose ")
+file(STRINGS "${SOURCE_DIR}/tests/package/consumer/CMakeLists.txt" consumer_line REGEX "^find_package\\(ecvpose ")
+if(NOT readme_line OR NOT readme_line STREQUAL consumer_line)
+  message(FATAL_ERROR "README.md's find_package line (${readme_line}) is not the consumer's (${consumer_line})")
+endif()
 file(REMOVE_RECURSE "${work}")
 function(run)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE out)

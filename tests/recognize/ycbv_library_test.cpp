@@ -459,9 +459,9 @@ TEST_F(YcbvLibrary, FindsTheGelatinBoxOfOneVideoInAComposite) {
   EXPECT_TRUE(evaluation.objects[0].correct) << run.output;
 }
 
-// Geometry first: the grey foam brick model (no texture) is judged by depth, fit, outline and continuation alone. At
-// its ground truth in 0000/000001 it is accepted, whatever the frame's colours (channels swapped: the same score);
-// moved 2 cm sideways it is rejected.
+// Geometry first (--plain-appearance 0.5): the grey foam brick model (no texture) is judged by depth, fit, outline and
+// continuation alone. At its ground truth in 0000/000001 it is accepted, whatever the frame's colours (channels
+// swapped: the same score); moved 2 cm sideways it is rejected.
 TEST_F(YcbvLibrary, AGreyModelIsAcceptedAtItsPoseByItsGeometryAndRejectedTwoCentimetresOff) {
   const std::string library_path = directory_->File("grey_brick.sqlite");
   const test::CommandResult build = test::RunCli(
@@ -477,6 +477,7 @@ TEST_F(YcbvLibrary, AGreyModelIsAcceptedAtItsPoseByItsGeometryAndRejectedTwoCent
   options.verify.min_score = 0.0;  // report the prior with its score
   options.verify.min_visible_fraction = 0.0;
   options.refine = false;  // the poses as given: ICP would pull the moved one back
+  options.verify.plain_appearance = 0.5;
   const double bar = RecognizerOptions().verify.min_score;
 
   const Detection right = test::VerifyPrior(library, options, frame.rgbd, "061_foam_brick", truth);
@@ -496,9 +497,9 @@ TEST_F(YcbvLibrary, AGreyModelIsAcceptedAtItsPoseByItsGeometryAndRejectedTwoCent
 
 // Untextured models (the YCB-Video meshes whose textures did not come through: grey, shaded views), added to the
 // suite's library: point pairs alone find the grey foam brick of 0000/000001 (ADD-S under 1 cm), and with both
-// sources a grey model absent from the frame (the tuna fish can, not in video 0001) is not reported while the
-// textured objects of 0001/000001 and the grey chef can are found. The grey chef can is a cylinder: its turn about
-// its axis cannot be told, so it is built symmetric (judged by ADD-S).
+// sources, grey models judged by their geometry (--plain-appearance 0.5), a grey model absent from the frame (the tuna
+// fish can, not in video 0001) is not reported while the textured objects of 0001/000001 and the grey chef can are
+// found. The grey chef can is a cylinder: its turn about its axis cannot be told, so it is built symmetric (ADD-S).
 TEST_F(YcbvLibrary, PointPairsFindAGreyModelAndReportNoAbsentOne) {
   const std::string library = directory_->File("with_grey.sqlite");
   std::filesystem::copy_file(library_, library);
@@ -538,7 +539,8 @@ TEST_F(YcbvLibrary, PointPairsFindAGreyModelAndReportNoAbsentOne) {
   }
   EXPECT_TRUE(brick_found) << brick.output;
 
-  const Run both = recognize(test::DataPath("ycbv_subset/Example-Scenes/0001/000001"), "--hypotheses both");
+  const Run both =
+      recognize(test::DataPath("ycbv_subset/Example-Scenes/0001/000001"), "--hypotheses both --plain-appearance 0.5");
   EXPECT_EQ(both.evaluation.false_positives, 0) << both.output;
   for (const Detection& detection : both.detections) EXPECT_NE(detection.model, "007_tuna_fish_can");
   for (const ObjectEvaluation& object : both.evaluation.objects) {
