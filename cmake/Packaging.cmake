@@ -7,12 +7,14 @@ install(TARGETS ${ecv_libraries} ecvpose
         RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+# The viewer, beside ecvpose, which it starts (camera/view/).
+install(TARGETS ecvpose-view RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 # The mesh importer program, in the folder where LoadMesh looks for it (io/mesh_io.cpp).
 install(TARGETS ecvpose-mesh-import RUNTIME DESTINATION ${CMAKE_INSTALL_LIBDIR}/ecvpose)
 
 # Public headers keep their folder: include/ecvpose/core/camera.h, include/ecvpose/render/...
 install(DIRECTORY src/core src/ecv src/io src/registration DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/ecvpose FILES_MATCHING PATTERN "*.h")
-foreach(stage render colorcal modeldb recognize)
+foreach(stage render colorcal modeldb recognize camera)
   install(DIRECTORY ${stage} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/ecvpose FILES_MATCHING PATTERN "*.h")
 endforeach()
 install(FILES "${PROJECT_BINARY_DIR}/generated/core/version.h" DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/ecvpose/core)

@@ -23,6 +23,7 @@ nlohmann::json RecognitionToJson(const RecognitionResult& result) {
                           {"edge_agreement", d.edge_agreement},
                           {"edge_pixels", d.edge_pixels},
                           {"tracked", d.tracked},
+                          {"confirmed", d.confirmed},
                           {"hypothesis", HypothesisSourceName(d.hypothesis)}});
   }
   return {{"detections", detections},

@@ -137,9 +137,17 @@ int RecognizeOneFrame(const RecognizeArgs& args, const LoadedFrame& loaded, cons
   return kExitOk;
 }
 
+// The overlay picture of the sequence's `number`th frame (from 1) in the --overlay directory: DIR/0001.png ...
+std::string OverlayPath(const std::string& directory, int number) {
+  char name[32];
+  std::snprintf(name, sizeof(name), "/%04d.png", number);
+  return directory + name;
+}
+
 // A sequence, processed in order as a camera stream would arrive; a broken frame is reported and skipped. Each
 // frame's JSON line and BOP rows are written as soon as it is done.
-int RecognizeSequence(const RecognizeArgs& args, FrameFeed& feed, const ModelLibrary& library, Recognizer& recognizer) {
+int RecognizeSequence(const RecognizeArgs& args, FrameSource& feed, const ModelLibrary& library,
+                      Recognizer& recognizer) {
   std::ostream& report = Report(args);
   LineOutput lines(args.out_json, "--out-json"), csv(args.out_bop, "--out-bop");
   if (csv.active()) csv.Write(kBopHeader);
@@ -149,16 +157,20 @@ int RecognizeSequence(const RecognizeArgs& args, FrameFeed& feed, const ModelLib
   RecognitionStream stream(recognizer, args.recognizer.stream);
   if (!args.overlay.empty()) std::filesystem::create_directories(args.overlay);
   while (const std::optional<std::string> frame = feed.Next()) {
-    FrameSpec spec;
-    spec.positional = *frame;
     try {
-      const LoadedFrame loaded = app::LoadFrameWithWarnings(spec);
+      const LoadedFrame loaded = feed.Load();
       const RecognitionResult result = stream.Next(loaded.rgbd);
       total_ms += result.timings_ms.at("total");
       report << feed.Counter();
       PrintDetections(report, loaded, result);
       nlohmann::json line = RecognitionToJson(result);
       line["frame"] = *frame;
+      // The picture is written before the frame's line, so that a reader of the lines (ecvpose-view) finds it whole.
+      if (!args.overlay.empty()) {
+        const std::string picture = OverlayPath(args.overlay, done + failed + 1);
+        WriteColorImage(picture, recognizer.DrawDetections(loaded.rgbd, result.detections));
+        line["overlay"] = picture;
+      }
       if (lines.active()) lines.Write(line.dump() + "\n");
       if (csv.active()) {
         std::ostringstream rows;
@@ -166,11 +178,6 @@ int RecognizeSequence(const RecognizeArgs& args, FrameFeed& feed, const ModelLib
         csv.Write(rows.str());
       }
       ++done;
-      if (!args.overlay.empty()) {
-        char name[32];
-        std::snprintf(name, sizeof(name), "/%04d.png", done + failed);
-        WriteColorImage(args.overlay + name, recognizer.DrawDetections(loaded.rgbd, result.detections));
-      }
     } catch (const InputError& error) {
       ++failed;
       stream.Reset();  // the priors are lost: the next frame searches every model
@@ -185,7 +192,23 @@ int RecognizeSequence(const RecognizeArgs& args, FrameFeed& feed, const ModelLib
   return failed > 0 ? kExitBadInput : kExitOk;
 }
 
-int RunRecognize(const RecognizeArgs& args) {
+// The frames of --sequence: a camera or a recording when `open_live` knows the source, else frame files.
+std::unique_ptr<FrameSource> OpenSequence(const RecognizeArgs& args, const FrameSourceOpener& open_live) {
+  if (open_live) {
+    if (std::unique_ptr<FrameSource> live = open_live(args.sequence, args.frame.camera)) {
+      if (args.follow) ThrowInputError(args.sequence, "--follow", "a folder of frame JSONs, not a camera or recording");
+      return live;
+    }
+  }
+  if (args.frame.camera) {
+    ThrowInputError(args.sequence, "--camera",
+                    "with --sequence, an openni2:// camera or a .oni recording (frame files "
+                    "carry their own intrinsics)");
+  }
+  return std::make_unique<FrameFeed>(args.sequence, args.follow, args.idle_timeout_s);
+}
+
+int RunRecognize(const RecognizeArgs& args, const FrameSourceOpener& open_live) {
   if (args.out_json == "-" && args.out_bop == "-") {
     std::cerr << "ecvpose recognize: --out-json and --out-bop cannot both be standard output (-)\n";
     return kExitBadUsage;
@@ -195,8 +218,8 @@ int RunRecognize(const RecognizeArgs& args) {
     return kExitBadUsage;
   }
   const RecognizerOptions options = OptionsFromArgs(args);
-  std::optional<FrameFeed> feed;
-  if (!args.sequence.empty()) feed.emplace(args.sequence, args.follow, args.idle_timeout_s);
+  std::unique_ptr<FrameSource> feed;
+  if (!args.sequence.empty()) feed = OpenSequence(args, open_live);
   // One frame is read first: a broken one is reported before the library and its meshes (seconds) are loaded.
   std::optional<LoadedFrame> single;
   if (!feed) single.emplace(app::LoadFrameWithWarnings(args.frame));
@@ -208,7 +231,7 @@ int RunRecognize(const RecognizeArgs& args) {
 
 }  // namespace
 
-CommandAction SetupRecognizeCommand(CLI::App& command) {
+CommandAction SetupRecognizeCommand(CLI::App& command, FrameSourceOpener open_live) {
   auto args = std::make_shared<RecognizeArgs>();
   AddRecognizerFlags(command, &args->recognizer);
   command.add_option("FRAME", args->frame.positional,
@@ -216,8 +239,9 @@ CommandAction SetupRecognizeCommand(CLI::App& command) {
   AddFrameFlags(command, &args->frame);
   command.add_option(
       "--sequence", args->sequence,
-      "Frames in order: a BOP scene folder, a YCB-Video video folder, a directory of frame JSONs, or a file with\n"
-      "one FRAME per line");
+      "Frames in order: a BOP scene folder, a YCB-Video video folder, a directory of frame JSONs, a file with\n"
+      "one FRAME per line, an OpenNI2 camera (openni2:// for the first, openni2://URI) or a FILE.oni recording\n"
+      "(intrinsics from --camera, else FILE.oni.json beside it, else the fields of view)");
   command.add_flag("--follow", args->follow,
                    "With --sequence FOLDER: also take the frame JSONs that appear in the folder while it runs (write\n"
                    "the images first, the JSON last, by rename), until --idle-timeout passes without a new one");
@@ -237,11 +261,12 @@ CommandAction SetupRecognizeCommand(CLI::App& command) {
                      "sequence from 0)");
   command.add_option("--overlay", args->overlay,
                      "Picture: each detected model in red with its name (PNG); with --sequence a directory,\n"
-                     "one DIR/0001.png ... per frame in sequence order");
+                     "one DIR/0001.png ... per frame in sequence order, written before the frame's --out-json\n"
+                     "line, which names it (\"overlay\")");
   command.footer(
       "Example:\n  ecvpose modeldb build models/meshes --db lib.sqlite\n"
       "  ecvpose recognize --db lib.sqlite models/frame/000001 --out-json detections.json --overlay detections.png");
-  return [args] { return RunRecognize(*args); };
+  return [args, open_live = std::move(open_live)] { return RunRecognize(*args, open_live); };
 }
 
 }  // namespace ecv::app

@@ -69,8 +69,8 @@ struct RankedView {
 };
 
 /// The detections JSON that `ecvpose recognize --out-json` writes: {"detections": [{"model", "score",
-/// "camera_from_object", "inlier_fraction", "fit_error", "view", ..., "tracked", "hypothesis"}], "timings_ms":
-/// {stage: ms}}.
+/// "camera_from_object", "inlier_fraction", "fit_error", "view", ..., "tracked", "confirmed", "hypothesis"}],
+/// "timings_ms": {stage: ms}}.
 nlohmann::json RecognitionToJson(const RecognitionResult& result);
 
 /// The detections of such JSON (model, score, camera_from_object, hypothesis); throws InputError naming `source`

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <thread>
 
+#include "app/frame_args.h"
 #include "core/error.h"
 #include "io/files.h"
 #include "io/frame_io.h"
@@ -70,6 +71,12 @@ std::optional<std::string> FrameFeed::Next() {
   }
   if (next_ == frames_.size()) return std::nullopt;
   return frames_[next_++];
+}
+
+LoadedFrame FrameFeed::Load() {
+  FrameSpec spec;
+  spec.positional = frames_.at(next_ - 1);
+  return LoadFrameWithWarnings(spec);
 }
 
 std::string FrameFeed::Counter() const {

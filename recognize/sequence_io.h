@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "recognize/frame_source.h"
+
 namespace ecv::app {
 
 /// Where results go line by line: a file, truncated when opened, or standard output for "-". Each Write reaches the
@@ -33,18 +35,21 @@ class LineOutput {
   bool owned_ = false;
 };
 
-/// The frames of --sequence, in order. With `follow`, the frame JSONs of a folder still being filled, in name order
-/// as they appear (a producer writes the images first and the JSON last, by rename), until `idle_timeout_s` pass
+/// The frame files of --sequence, in order. With `follow`, the frame JSONs of a folder still being filled, in name
+/// order as they appear (a producer writes the images first and the JSON last, by rename), until `idle_timeout_s` pass
 /// without a new one.
-class FrameFeed {
+class FrameFeed : public FrameSource {
  public:
   FrameFeed(const std::string& sequence, bool follow, double idle_timeout_s);
 
-  /// The next frame; nothing at the end.
-  std::optional<std::string> Next();
+  /// The next frame's file (FRAME); nothing at the end.
+  std::optional<std::string> Next() override;
+
+  /// The frame Next named, read with the frame readers' warnings on stderr.
+  LoadedFrame Load() override;
 
   /// "[3/10] " for a list of known length, "[3] " when following.
-  std::string Counter() const;
+  std::string Counter() const override;
 
  private:
   void Scan();  // adds the folder's frame JSONs not seen yet, in name order

@@ -14,6 +14,7 @@ poses 4x4 float64 arrays in metres. Bad input raises InputError (a ValueError) n
 """
 
 from ._ecvpose import (  # noqa: F401
+    Camera,
     Detection,
     Frame,
     InputError,
@@ -25,11 +26,13 @@ from ._ecvpose import (  # noqa: F401
     build_models,
     list_frames,
     load_frame,
+    open_camera,
     render,
     write_image,
 )
 
 __all__ = [
+    "Camera",
     "Detection",
     "Frame",
     "InputError",
@@ -41,6 +44,7 @@ __all__ = [
     "build_models",
     "list_frames",
     "load_frame",
+    "open_camera",
     "render",
     "write_image",
 ]

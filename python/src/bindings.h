@@ -12,6 +12,9 @@ void BindLibrary(py::module_& m);
 /// Frame, load_frame, Detection and Recognizer.
 void BindRecognizer(py::module_& m);
 
+/// Camera and open_camera (OpenNI2 devices and .oni recordings); after BindRecognizer, which binds Frame.
+void BindCamera(py::module_& m);
+
 inline constexpr const char* kBuildModelsDoc = R"(Builds a model library from meshes, as `ecvpose modeldb build` does.
 
 db: the library's path (created if missing; a model of the same name is replaced).

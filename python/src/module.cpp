@@ -25,4 +25,5 @@ PYBIND11_MODULE(_ecvpose, m) {
   py::register_exception<ecv::RenderError>(m, "RenderError", PyExc_RuntimeError);
   ecv::python::BindLibrary(m);
   ecv::python::BindRecognizer(m);
+  ecv::python::BindCamera(m);
 }

@@ -5,6 +5,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "recognize/frame_source.h"
+
 namespace ecv::app {
 
 /// Exit codes of every subcommand.
@@ -35,9 +37,14 @@ CommandAction SetupFeaturesCommand(CLI::App& command);
 CommandAction SetupRenderCommand(CLI::App& command);   // render/render_command.cpp
 CommandAction SetupModeldbCommand(CLI::App& command);  // modeldb/modeldb_command.cpp
 CommandAction SetupRegisterCommand(CLI::App& command);
-CommandAction SetupColorcalCommand(CLI::App& command);   // colorcal/colorcal_command.cpp
-CommandAction SetupRecognizeCommand(CLI::App& command);  // recognize/recognize_command.cpp
-CommandAction SetupServeCommand(CLI::App& command);      // recognize/serve_command.cpp
-CommandAction SetupEvalCommand(CLI::App& command);       // recognize/eval_command.cpp
+CommandAction SetupColorcalCommand(CLI::App& command);  // colorcal/colorcal_command.cpp
+/// `open_live` opens the --sequence sources beyond files (camera/: OpenNI2 devices and recordings).
+CommandAction SetupRecognizeCommand(CLI::App& command, FrameSourceOpener open_live);  // recognize/recognize_command.cpp
+CommandAction SetupServeCommand(CLI::App& command);                                   // recognize/serve_command.cpp
+CommandAction SetupEvalCommand(CLI::App& command);                                    // recognize/eval_command.cpp
+CommandAction SetupRecordCommand(CLI::App& command);                                  // camera/camera_command.cpp
+/// Opens openni2:// cameras and .oni recordings as frame sources; nullptr for other sequences (camera_command.cpp).
+std::unique_ptr<FrameSource> OpenCameraSource(const std::string& sequence,
+                                              const std::optional<std::string>& intrinsics);
 
 }  // namespace ecv::app

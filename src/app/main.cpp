@@ -30,11 +30,13 @@ const Subcommand kSubcommands[] = {
     {"register", "Align two views of a scene (ECV context + prerejective RANSAC + ICP); writes b_from_a",
      ecv::app::SetupRegisterCommand},
     {"recognize", "Find the library's objects with their 6D poses in RGB-D frames; JSON and a picture",
-     ecv::app::SetupRecognizeCommand},
+     [](CLI::App& command) { return ecv::app::SetupRecognizeCommand(command, ecv::app::OpenCameraSource); }},
     {"serve", "Keep the library loaded and answer recognition requests, JSON lines on stdin or a Unix socket",
      ecv::app::SetupServeCommand},
     {"eval", "Score detections against ground truth: rotation, translation, ADD, ADD-S, recall",
      ecv::app::SetupEvalCommand},
+    {"record", "Record an OpenNI2 camera or any frame sequence as an .oni file (lossless), K beside it",
+     ecv::app::SetupRecordCommand},
 };
 
 }  // namespace

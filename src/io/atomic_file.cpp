@@ -1,32 +1,37 @@
 #include "io/atomic_file.h"
 
 #include <filesystem>
-#include <fstream>
 #include <system_error>
 
 #include "core/error.h"
 
 namespace ecv {
 
-void WriteFileAtomically(const std::string& path, const std::string& bytes) {
-  const std::string temporary = path + ".tmp";
+AtomicFile::AtomicFile(const std::string& path) : path_(path), temporary_(path + ".tmp") {
+  stream_.open(temporary_, std::ios::binary | std::ios::trunc);
+  if (!stream_) ThrowInputError(path, "output", "a writable location");
+}
+
+AtomicFile::~AtomicFile() {
+  if (committed_) return;
+  stream_.close();
   std::error_code ignored;
-  {
-    std::ofstream stream(temporary, std::ios::binary);
-    if (!stream) ThrowInputError(path, "output", "a writable location");
-    stream.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    if (!stream.flush()) {
-      stream.close();
-      std::filesystem::remove(temporary, ignored);
-      ThrowInputError(path, "output", "a writable location with free space");
-    }
-  }
+  std::filesystem::remove(temporary_, ignored);
+}
+
+void AtomicFile::Commit() {
+  if (!stream_.flush()) ThrowInputError(path_, "output", "a writable location with free space");
+  stream_.close();
   std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) {
-    std::filesystem::remove(temporary, ignored);
-    ThrowInputError(path, "output", "a writable location", error.message());
-  }
+  std::filesystem::rename(temporary_, path_, error);
+  if (error) ThrowInputError(path_, "output", "a writable location", error.message());
+  committed_ = true;
+}
+
+void WriteFileAtomically(const std::string& path, const std::string& bytes) {
+  AtomicFile file(path);
+  file.stream().write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  file.Commit();
 }
 
 }  // namespace ecv
