@@ -309,12 +309,23 @@ void AppendDetections(const std::string& path, const Run& run, const std::vector
     RecognitionResult result;
     result.detections = run.detections[k];
     nlohmann::json found = nlohmann::json::object();
-    for (const ObjectEvaluation& object : run.evaluations[k].objects) found[object.model] = object.correct;
+    nlohmann::json errors = nlohmann::json::array();  // of the detection each object took, or its best wrong one
+    for (const ObjectEvaluation& object : run.evaluations[k].objects) {
+      found[object.model] = object.correct;
+      if (!object.detected) continue;
+      errors.push_back({{"model", object.model},
+                        {"rotation_deg", object.error.rotation_deg},
+                        {"translation_mm", object.error.translation_mm},
+                        {"add_mm", 1000.0 * object.error.add_m},
+                        {"adds_mm", 1000.0 * object.error.adds_m},
+                        {"diameter_mm", 1000.0 * object.diameter_m}});
+    }
     out << nlohmann::json{{"run", run.label},
                           {"set", frame.set},
                           {"condition", frame.condition},
                           {"frame", frame.name},
                           {"found", found},
+                          {"errors", errors},
                           {"false_positives", run.evaluations[k].false_positive_models},
                           {"detections", RecognitionToJson(result)["detections"]}}
                .dump()
@@ -342,7 +353,7 @@ int Main(int argc, char** argv) {
   app.add_option("--results", s.results, "Markdown file the report goes to");
   app.add_option("--detections", s.detections,
                  "JSON Lines file every run's detections are appended to, per frame with their verification terms "
-                 "and which were right");
+                 "and which were right, with each found or wrongly placed object's pose errors");
   s.recognizer.options.ransac.threads = 2;  // the benchmark machine's cores
   AddSettingFlags(app, &s.recognizer, {"hypotheses", "track"},
                   "Settings of every run (as `ecvpose recognize` takes them)");

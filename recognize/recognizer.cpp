@@ -10,6 +10,7 @@
 #include "colorcal/color_matrix.h"
 #include "core/error.h"
 #include "core/parallel.h"
+#include "core/pose.h"
 #include "core/timing.h"
 #include "ecv/descriptor.h"
 #include "modeldb/model_builder.h"
@@ -82,6 +83,7 @@ class Recognizer::Impl {
     ppf_models_.resize(models.size());
     ppf_refusals_.resize(models.size());
     plain_.resize(models.size());
+    axes_.resize(models.size());
     const bool point_pairs = options_.point_pairs.source != HypothesisSource::kContext;
     for (size_t first = 0; first < models.size(); first += batch) {
       std::vector<TriangleMesh> meshes(std::min(batch, models.size() - first));
@@ -91,6 +93,7 @@ class Recognizer::Impl {
         records_[first + i].mesh_blob = {};  // the copy's bytes: the renderer holds the mesh
         closed[first + i] = meshes[i].IsClosedOutward() ? 1 : 0;
         plain_[first + i] = OneColoured(meshes[i]) ? 1 : 0;
+        axes_[first + i] = meshes[i].PrincipalAxesBox();
         if (point_pairs) {
           ppf_models_[first + i] = MakePointPairModel(models[first + i].record, meshes[i], &ppf_refusals_[first + i]);
         }
@@ -256,12 +259,54 @@ class Recognizer::Impl {
           first || options_.later_instance_views == 0 ? options_.views_per_model : options_.later_instance_views;
       std::optional<Verified> best =
           search.BestPose(views, first ? options_.give_up_after_views : 0, model->covered, &ranked, &result.times);
+      if (best && options_.twins.enabled) best = BestTwin(m, scene, std::move(*best), &result.times);
       if (!best || !Accepted(best->detection)) break;
       AddInstance(std::move(*best), options_.dense_stride_px, scene.frame->depth.size(), model);
     }
     result.views_tried = static_cast<int>(
         std::count_if(ranked.begin(), ranked.end(), [](const ViewCandidate& view) { return view.tried; }));
     return result;
+  }
+
+  // Geometry first: whether `turned` fits the frame's depth as well as `pose` (TwinOptions::fit_margin_m,
+  // contour_margin), so that its appearance may decide between them.
+  bool FitsAsWell(const Detection& turned, const Detection& pose) const {
+    return turned.surface_error_m <= pose.surface_error_m + options_.twins.fit_margin_m &&
+           turned.contour_agreement >= pose.contour_agreement - options_.twins.contour_margin;
+  }
+
+  // `pose`, or the best of its turns by 180 degrees about the model's principal axes (each refined by ICP when it
+  // scored rival_min_ratio of `pose`) that beats it (TwinOptions). Adds verification and ICP times.
+  Verified BestTwin(size_t model, const Scene& scene, Verified pose, StageTimes* times) {
+    const PrincipalBox& principal = axes_[model];
+    const Detection original = pose.detection;
+    const ModelSearch search = Search(model, scene, 1);
+    for (int axis = 0; axis < 3; ++axis) {
+      Hypothesis hypothesis;
+      hypothesis.view = original.view;
+      hypothesis.ransac.inlier_fraction = original.inlier_fraction;
+      hypothesis.ransac.fit_error_m = original.fit_error_m;
+      hypothesis.pose = TurnedHalfWayAbout(original.camera_from_object, principal.centre, principal.axes.col(axis));
+      Clock::time_point stage = Clock::now();
+      Verified turned = Verify(model, scene, hypothesis);
+      times->Add(Stage::kVerify, MillisecondsSince(stage));
+      if (options_.refine && turned.search_score > 0.0 &&
+          turned.search_score >= options_.rival_min_ratio * pose.search_score) {
+        stage = Clock::now();
+        search.Refine(turned.depth, &hypothesis);
+        times->Add(Stage::kRefine, MillisecondsSince(stage));
+        stage = Clock::now();
+        Verified refined = Verify(model, scene, hypothesis);
+        times->Add(Stage::kVerify, MillisecondsSince(stage));
+        if (refined.detection.score >= turned.detection.score) turned = std::move(refined);
+      }
+      if (turned.detection.score > options_.twins.min_gain * pose.detection.score &&
+          FitsAsWell(turned.detection, pose.detection)) {
+        turned.detection.hypothesis = original.hypothesis;
+        pose = std::move(turned);
+      }
+    }
+    return pose;
   }
 
   // A prior's model at the prior's pose, refined by ICP when that raises the score (its RANSAC fields stay 0).
@@ -324,6 +369,7 @@ class Recognizer::Impl {
     std::vector<StageTimes> model_times(wanted.size());
     ParallelFor(wanted.size(), options_.ransac.threads, [&](size_t i) {
       std::optional<Verified> best = BestPointPairPose(wanted[i], scene, points, &model_times[i]);
+      if (best && options_.twins.enabled) best = BestTwin(wanted[i], scene, std::move(*best), &model_times[i]);
       if (best && Accepted(best->detection)) {
         AddInstance(std::move(*best), options_.dense_stride_px, scene.frame->depth.size(), &(*models)[wanted[i]]);
       }
@@ -456,7 +502,8 @@ class Recognizer::Impl {
   std::vector<RenderOptions> render_options_;        // per model: shaded as its library views are
   std::vector<std::optional<PpfModel>> ppf_models_;  // per model, with point pair hypotheses: its table, if any
   std::vector<std::string> ppf_refusals_;            // per model without a table: why
-  std::vector<char> plain_;  // per model: painted in material colours alone (VerifyOptions::plain_appearance)
+  std::vector<char> plain_;         // per model: painted in material colours alone (VerifyOptions::plain_appearance)
+  std::vector<PrincipalBox> axes_;  // per model: about which its poses are turned (TwinOptions)
 };
 
 cv::Mat Recognizer::Impl::DrawDetections(const RgbdFrame& frame, const std::vector<Detection>& detections) {

@@ -44,6 +44,15 @@ HypothesisSource ParseHypothesisSource(const std::string& name, const std::strin
   ThrowInputError(what, "hypotheses", "context, ppf or both", "'" + name + "'");
 }
 
+void TwinOptions::Check() const {
+  const auto require = [](bool ok, const char* field, const char* expected) {
+    if (!ok) ThrowInputError("recognizer options", field, expected);
+  };
+  require(min_gain >= 1.0 && min_gain <= 10.0, "twins.min_gain", "in [1, 10]");
+  require(fit_margin_m >= 0.0 && fit_margin_m <= 0.1, "twins.fit_margin_m", "in [0, 0.1] metres");
+  require(contour_margin >= 0.0 && contour_margin <= 1.0, "twins.contour_margin", "in [0, 1]");
+}
+
 void RecognizerOptions::Check() const {
   match.Check();
   ransac.Check();
@@ -52,6 +61,7 @@ void RecognizerOptions::Check() const {
   ranking.consistency.Check();
   point_pairs.ppf.Check();
   point_pairs.plane.Check();
+  twins.Check();
   auto require = [](bool ok, const char* field, const char* expected) {
     if (!ok) ThrowInputError("recognizer options", field, expected);
   };

@@ -69,6 +69,25 @@ struct PointPairOptions {
   int model_samples = PpfModelSampling().samples;
 };
 
+/// A near-symmetric object's sides: a box's front and back, a can's print and a banana's ends fit the depth alike,
+/// so that a pose from the wrong side is turned 180 degrees from the truth with its surface in place. Each searched
+/// model's best pose is also verified turned 180 degrees about each of the model's principal axes (through the middle
+/// of its extent), each turn refined by ICP when it scored RecognizerOptions::rival_min_ratio of the pose.
+struct TwinOptions {
+  bool enabled = true;
+  /// A turn replaces the pose only when it scores at least this many times the pose's score: the pose has RANSAC's
+  /// correspondences behind it, the turn none.
+  double min_gain = 1.1;
+  /// Geometry first: and only when it fits the depth as well, its mean surface residual at most fit_margin_m above
+  /// the pose's (metres) and its share of outline on depth steps at most contour_margin below: appearance tells sides
+  /// apart only where the shape cannot (a banana's two ends have the same yellow, but not the same curve).
+  double fit_margin_m = 0.001;
+  double contour_margin = 0.1;
+
+  /// Throws InputError on values outside their ranges.
+  void Check() const;
+};
+
 /// Settings of the online recognizer (paper Sect. III and IV-C, and what goes beyond it). bench/RESULTS.md,
 /// "Recognizer defaults", gives the measurements behind each default.
 struct RecognizerOptions {
@@ -95,6 +114,8 @@ struct RecognizerOptions {
   /// verified too when it scored at least this share of the best (0: never): coarse poses of a bottle's front and
   /// back score alike before ICP, and which one is refined decides.
   double rival_min_ratio = 0.7;
+  /// Each searched model's best pose is also tried turned 180 degrees about the model's principal axes.
+  TwinOptions twins;
   /// The scene's contexts take at most this many neighbours when the library's setting allows more (0: the
   /// library's): pairs grow with its square, so it bounds the describe time of close-ups.
   int scene_max_neighbours = 128;

@@ -260,6 +260,11 @@ void AddFurtherSettings(std::vector<Setting>* table) {
       "A model's best pose turned more than 90 degrees from its best verified one is refined and verified\n"
       "too when it scored at least this share of the best (0: never)",
       [](auto& s) -> auto& { return s.options.rival_min_ratio; }));
+  table->push_back(Flag(
+      "twins", true,
+      "Do not verify each searched model's best pose turned 180 degrees about the model's principal axes\n"
+      "(a box's front and back fit the depth alike: its colours and edges tell them apart)",
+      [](auto& s) -> auto& { return s.options.twins.enabled; }));
   table->push_back(Count(
       "later-instance-views", 0, kNoMax,
       "With --max-instances: views tried for each instance after a model's first (0: --views-per-model)",

@@ -7,6 +7,7 @@
 #include <numeric>
 #include <utility>
 
+#include <Eigen/Eigenvalues>
 #include <opencv2/imgproc.hpp>
 
 namespace ecv {
@@ -45,6 +46,32 @@ Eigen::AlignedBox3d TriangleMesh::BoundingBox() const {
   for (const MeshPart& part : parts) {
     for (const Eigen::Vector3f& p : part.positions) box.extend(p.cast<double>());
   }
+  return box;
+}
+
+PrincipalBox TriangleMesh::PrincipalAxesBox() const {
+  PrincipalBox box;
+  const size_t count = NumVertices();
+  if (count == 0) return box;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const MeshPart& part : parts) {
+    for (const Eigen::Vector3f& p : part.positions) mean += p.cast<double>();
+  }
+  mean /= static_cast<double>(count);
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const MeshPart& part : parts) {
+    for (const Eigen::Vector3f& p : part.positions) {
+      const Eigen::Vector3d d = p.cast<double>() - mean;
+      scatter += d * d.transpose();
+    }
+  }
+  box.axes = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors();
+  Eigen::AlignedBox3d along;  // the vertices in the axes' frame
+  for (const MeshPart& part : parts) {
+    for (const Eigen::Vector3f& p : part.positions) along.extend(box.axes.transpose() * p.cast<double>());
+  }
+  box.centre = box.axes * along.center();
+  box.half_sizes = 0.5 * along.sizes();
   return box;
 }
 

@@ -37,6 +37,13 @@ struct MeshPart {
 /// meshes (io/mesh_blob.h), so that both give the same pixels; 0 keeps every size.
 cv::Mat CapTextureSize(const cv::Mat& texture, int max_side);
 
+/// A box along a point set's principal axes.
+struct PrincipalBox {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();      ///< the middle of the extent along the axes, metres
+  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();    ///< unit columns, least spread first
+  Eigen::Vector3d half_sizes = Eigen::Vector3d::Zero();  ///< along each axis, metres
+};
+
 /// A triangle mesh in the object frame (metres), as loaded by io/mesh_io.h.
 struct TriangleMesh {
   std::string name;  ///< file stem unless given
@@ -55,6 +62,10 @@ struct TriangleMesh {
 
   /// Largest distance between two vertices, metres (exact; as BOP's models_info "diameter").
   double Diameter() const;
+
+  /// The box along the principal axes of the vertices (eigenvectors of their scatter) that holds them all; the
+  /// identity axes and a zero box for an empty mesh.
+  PrincipalBox PrincipalAxesBox() const;
 
   /// True when the triangles, over all parts, close into surfaces whose faces all turn their counter-clockwise
   /// side outwards: every edge (vertices compared by position, so texture seams do not open it) is run through

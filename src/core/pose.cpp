@@ -31,6 +31,14 @@ Eigen::Isometry3d RigidFromMatrix(const Eigen::Matrix4d& matrix, const std::stri
   return rigid;
 }
 
+Eigen::Isometry3d TurnedHalfWayAbout(const Eigen::Isometry3d& camera_from_object, const Eigen::Vector3d& centre,
+                                     const Eigen::Vector3d& axis) {
+  Eigen::Isometry3d turn = Eigen::Isometry3d::Identity();
+  turn.linear() = Eigen::AngleAxisd(M_PI, axis.normalized()).toRotationMatrix();
+  turn.translation() = centre - turn.linear() * centre;  // the line through `centre` stays in place
+  return camera_from_object * turn;
+}
+
 double RotationAngle(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
   const Eigen::Matrix3d relative = a.linear().transpose() * b.linear();
   const double cosine = std::clamp((relative.trace() - 1.0) / 2.0, -1.0, 1.0);

@@ -17,6 +17,11 @@ namespace ecv {
 Eigen::Isometry3d RigidFromMatrix(const Eigen::Matrix4d& matrix, const std::string& source, const std::string& field,
                                   double tolerance = 1e-2);
 
+/// `camera_from_object` turned 180 degrees about the object-frame line through `centre` along `axis` (need not be
+/// unit): for an object nearly symmetric about that line the turned pose puts its surface where it was.
+Eigen::Isometry3d TurnedHalfWayAbout(const Eigen::Isometry3d& camera_from_object, const Eigen::Vector3d& centre,
+                                     const Eigen::Vector3d& axis);
+
 /// Angle of the rotation that takes `a` to `b`, radians in [0, pi].
 double RotationAngle(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b);
 

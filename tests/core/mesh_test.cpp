@@ -30,6 +30,26 @@ TEST(TriangleMesh, CountsBoxAndDiameterOfACube) {
   EXPECT_NEAR(cube.Diameter(), 0.1 * std::sqrt(3.0), 1e-7);
 }
 
+// A box of 0.2 x 0.1 x 0.04 m, turned and moved: its principal axes are its edges, least spread first, and its
+// principal box is the box itself.
+TEST(TriangleMesh, PrincipalAxesBoxOfATurnedBoxIsTheBox) {
+  TriangleMesh box = Cube(1.0);
+  Eigen::Isometry3d placed = Eigen::Isometry3d::Identity();
+  placed.linear() = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix() *
+                    Eigen::Vector3d(0.2, 0.1, 0.04).asDiagonal();
+  placed.translation() = Eigen::Vector3d(0.3, -0.1, 0.5);
+  for (Eigen::Vector3f& p : box.parts[0].positions) p = (placed * p.cast<double>()).cast<float>();
+
+  const PrincipalBox principal = box.PrincipalAxesBox();
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  EXPECT_NEAR((principal.centre - placed * Eigen::Vector3d(0.5, 0.5, 0.5)).norm(), 0.0, 1e-6);
+  EXPECT_NEAR(std::abs(principal.axes.col(0).dot(turn.col(2))), 1.0, 1e-6);  // 4 cm: least spread
+  EXPECT_NEAR(std::abs(principal.axes.col(1).dot(turn.col(1))), 1.0, 1e-6);
+  EXPECT_NEAR(std::abs(principal.axes.col(2).dot(turn.col(0))), 1.0, 1e-6);  // 20 cm: most spread
+  EXPECT_NEAR((principal.half_sizes - Eigen::Vector3d(0.02, 0.05, 0.1)).norm(), 0.0, 1e-6);
+  EXPECT_EQ(TriangleMesh().PrincipalAxesBox().half_sizes, Eigen::Vector3d::Zero());
+}
+
 TEST(TriangleMesh, ClosedOutwardNeedsEveryEdgeRunBothWaysAndFacesTurnedOut) {
   TriangleMesh inward = Cube(0.1);  // Cube's triangles run clockwise seen from outside
   EXPECT_FALSE(inward.IsClosedOutward()) << "closed, but turned inwards";

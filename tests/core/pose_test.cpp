@@ -24,6 +24,22 @@ TEST(Pose, RotationAngleAndTranslationDistance) {
   EXPECT_NEAR(TranslationDistance(a, MakePose(0.0, {1, 0, 0}, {0.1, 0.2, 0.35})), 0.05, 1e-12);
 }
 
+// A pose turned half way about a line of the object keeps that line's points where they were, moves the others
+// (turned 180 degrees) and turned twice is the pose again.
+TEST(Pose, TurnedHalfWayAboutKeepsTheLineInPlace) {
+  const Eigen::Isometry3d pose = MakePose(0.4, {0, 1, 1}, {0.1, 0.0, 0.8});
+  const Eigen::Vector3d centre(0.02, 0.03, -0.01), axis(0.0, 0.0, 2.0);
+  const Eigen::Isometry3d turned = TurnedHalfWayAbout(pose, centre, axis);
+  EXPECT_NEAR(RotationAngle(pose, turned), M_PI, 1e-9);
+  for (const double along : {-0.1, 0.0, 0.05}) {
+    const Eigen::Vector3d on_line = centre + along * axis.normalized();
+    EXPECT_NEAR((turned * on_line - pose * on_line).norm(), 0.0, 1e-12);
+  }
+  const Eigen::Vector3d off = centre + Eigen::Vector3d(0.03, 0.0, 0.0);  // 3 cm off the line: 6 cm across
+  EXPECT_NEAR((turned * off - pose * off).norm(), 0.06, 1e-12);
+  EXPECT_NEAR((TurnedHalfWayAbout(turned, centre, axis).matrix() - pose.matrix()).norm(), 0.0, 1e-12);
+}
+
 TEST(Pose, RigidFromMatrixKeepsRigidTransforms) {
   const Eigen::Isometry3d pose = MakePose(1.1, {0.2, -1, 0.5}, {0.4, -0.3, 1.2});
   const Eigen::Isometry3d parsed = RigidFromMatrix(pose.matrix(), "test", "pose");
