@@ -5,6 +5,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
@@ -31,13 +33,24 @@ std::string OpenNiError() {
                                     : text.substr(start, text.find_last_not_of(" \t\n") - start + 1);
 }
 
-// The connected devices' URIs, for a message ("none" when there are none).
-std::string ConnectedDevices() {
+// The connected cameras, URI and name: OpenNI2's device list without the recordings this process has opened (its file
+// driver lists each as a device while OpenNI2 runs).
+std::vector<std::pair<std::string, std::string>> ConnectedCameras() {
   openni::Array<openni::DeviceInfo> devices;
   openni::OpenNI::enumerateDevices(&devices);
-  std::string list;
+  std::vector<std::pair<std::string, std::string>> cameras;
   for (int i = 0; i < devices.getSize(); ++i) {
-    list += (i > 0 ? ", " : "") + std::string(kScheme) + devices[i].getUri() + " (" + devices[i].getName() + ")";
+    const std::string uri = devices[i].getUri();
+    if (!IsRecording(uri)) cameras.emplace_back(uri, devices[i].getName());
+  }
+  return cameras;
+}
+
+// The connected cameras for a message ("none" when there are none).
+std::string ConnectedDevices() {
+  std::string list;
+  for (const auto& [uri, name] : ConnectedCameras()) {
+    list += (list.empty() ? "" : ", ") + std::string(kScheme) + uri + " (" + name + ")";
   }
   return list.empty() ? "none" : list;
 }
@@ -182,13 +195,22 @@ void OpenNiCamera::Impl::Open() {
     CheckOniFile(source);
   }
   InitializeOpenNi();
-  const std::string uri = recording ? source : source.substr(std::string(kScheme).size());
-  if (device.open(uri.empty() ? openni::ANY_DEVICE : uri.c_str()) != openni::STATUS_OK) {
+  std::string uri = recording ? source : source.substr(std::string(kScheme).size());
+  const bool first_camera = uri.empty();
+  if (first_camera) {
+    const auto cameras = ConnectedCameras();
+    if (cameras.empty()) {
+      ThrowInputError(source, "device", "a connected OpenNI2 device (Kinect, Asus Xtion, Orbbec)",
+                      "none connected (" + OpenNiError() + ")");
+    }
+    uri = cameras.front().first;
+  }
+  if (device.open(uri.c_str()) != openni::STATUS_OK) {
     const std::string reason = OpenNiError();
     if (recording) ThrowInputError(source, "recording", "a recording OpenNI2 can play", reason);
     ThrowInputError(source, "device",
-                    uri.empty() ? "a connected OpenNI2 device (Kinect, Asus Xtion, Orbbec)"
-                                : "a connected OpenNI2 device with URI '" + uri + "'",
+                    first_camera ? "a connected OpenNI2 device (Kinect, Asus Xtion, Orbbec)"
+                                 : "a connected OpenNI2 device with URI '" + uri + "'",
                     reason + "; connected devices: " + ConnectedDevices());
   }
   if (recording) {
