@@ -268,6 +268,23 @@ class Recognizer::Impl {
     return result;
   }
 
+  // `hypothesis` refined by ICP from `verified` (its verification) and verified again; both are replaced when that
+  // does not lower the score. Adds ICP and verification times.
+  void RefineIfBetter(size_t model, const Scene& scene, const ModelSearch& search, Hypothesis* hypothesis,
+                      Verified* verified, StageTimes* times) {
+    Hypothesis refined_hypothesis = *hypothesis;
+    Clock::time_point stage = Clock::now();
+    search.Refine(verified->depth, &refined_hypothesis);
+    times->Add(Stage::kRefine, MillisecondsSince(stage));
+    stage = Clock::now();
+    Verified refined = Verify(model, scene, refined_hypothesis);
+    times->Add(Stage::kVerify, MillisecondsSince(stage));
+    if (refined.detection.score >= verified->detection.score) {
+      *hypothesis = refined_hypothesis;
+      *verified = std::move(refined);
+    }
+  }
+
   // Geometry first: whether `turned` fits the frame's depth as well as `pose` (TwinOptions::fit_margin_m,
   // contour_margin), so that its appearance may decide between them.
   bool FitsAsWell(const Detection& turned, const Detection& pose) const {
@@ -287,18 +304,12 @@ class Recognizer::Impl {
       hypothesis.ransac.inlier_fraction = original.inlier_fraction;
       hypothesis.ransac.fit_error_m = original.fit_error_m;
       hypothesis.pose = TurnedHalfWayAbout(original.camera_from_object, principal.centre, principal.axes.col(axis));
-      Clock::time_point stage = Clock::now();
+      const Clock::time_point stage = Clock::now();
       Verified turned = Verify(model, scene, hypothesis);
       times->Add(Stage::kVerify, MillisecondsSince(stage));
       if (options_.refine && turned.search_score > 0.0 &&
           turned.search_score >= options_.rival_min_ratio * pose.search_score) {
-        stage = Clock::now();
-        search.Refine(turned.depth, &hypothesis);
-        times->Add(Stage::kRefine, MillisecondsSince(stage));
-        stage = Clock::now();
-        Verified refined = Verify(model, scene, hypothesis);
-        times->Add(Stage::kVerify, MillisecondsSince(stage));
-        if (refined.detection.score >= turned.detection.score) turned = std::move(refined);
+        RefineIfBetter(model, scene, search, &hypothesis, &turned, times);
       }
       if (turned.detection.score > options_.twins.min_gain * pose.detection.score &&
           FitsAsWell(turned.detection, pose.detection)) {
@@ -392,15 +403,7 @@ class Recognizer::Impl {
       stage = Clock::now();
       Verified verified = Verify(model, scene, hypothesis);
       times->Add(Stage::kVerify, MillisecondsSince(stage));
-      if (options_.refine) {
-        stage = Clock::now();
-        search.Refine(verified.depth, &hypothesis);
-        times->Add(Stage::kRefine, MillisecondsSince(stage));
-        stage = Clock::now();
-        Verified refined = Verify(model, scene, hypothesis);
-        times->Add(Stage::kVerify, MillisecondsSince(stage));
-        if (refined.detection.score >= verified.detection.score) verified = std::move(refined);
-      }
+      if (options_.refine) RefineIfBetter(model, scene, search, &hypothesis, &verified, times);
       verified.detection.hypothesis = HypothesisSource::kPpf;
       if (!best || verified.detection.score > best->detection.score) best = std::move(verified);
     }
