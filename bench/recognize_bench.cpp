@@ -7,8 +7,9 @@
 //
 //   scripts/build_ycbv_library /tmp/ycbv.sqlite --views 40 --distance 0.9
 //   scripts/build_lmo_library /tmp/lmo.sqlite --views 40 --distance 1.0
-//   recognize_bench --db /tmp/ycbv.sqlite [--lmo-db /tmp/lmo.sqlite] [--peers] [--track] [--search-every N...]
-//                   [--confirm-every N...] [--confirm-first N...] [--track-score S] [--seeds S...]
+//   recognize_bench --db /tmp/ycbv.sqlite [--db MORE.sqlite...] [--lmo-db /tmp/lmo.sqlite] [--peers] [--track]
+//                   [--search-every N...] [--confirm-every N...] [--confirm-first N...] [--track-score S] [--seeds
+//                   S...]
 //                   [--threads N...] [--bytes] [--preselect N...] [--turned] [--casts] [--python EXE] [--figure F.jpg]
 //                   [--results bench/RESULTS.md] [--frames N] [the settings flags of `ecvpose recognize`]
 // Every setting of the recognizer's table (recognize/recognizer_settings.h) is a flag, as in `ecvpose recognize`,
@@ -24,6 +25,8 @@
 // --confirm-every N... adds tracking runs with each TrackingOptions::confirm_every for each of --seeds (and each
 // --confirm-first, and with --casts under each light), and
 // --track-score S sets the follow score of every tracking run (recognize --track-score).
+// --db repeated runs every run of ours with each library in turn (the peers and --figure with the first): a block of
+// rows per library in the recall table, a row per library in each time table with its ratio to the first library's.
 // --figure F.jpg draws the detections of ours and each peer in frame 0001/000001 (the demo frame) side by side.
 // --object-pixels also runs the peers on depth cut to the ground-truth objects' own pixels; --peers-only,
 // --frame-step, --ppf-sampling, --ppf-scene-distance and --min-inlier-fraction are for tuning the peers.
@@ -32,8 +35,10 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <map>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -214,91 +219,150 @@ int FollowedFalsePositives(const Run& run) {
   return followed;
 }
 
-// Per object: correct / present; then recall, false positives and the median time per frame.
-std::string RecallTable(const Runs& runs) {
-  std::map<std::string, std::map<std::string, std::pair<int, int>>> counts;  // object -> run -> (correct, present)
-  std::map<std::string, int> false_positives;
+// The run labelled `label` in `runs`, or null.
+const Run* FindRun(const Runs& runs, const std::string& label) {
+  const auto found = std::find_if(runs.begin(), runs.end(), [&](const auto& run) { return run.first == label; });
+  return found == runs.end() ? nullptr : &found->second;
+}
+
+// The run labelled `label` (it must be there).
+const Run& RunNamed(const Runs& runs, const std::string& label) {
+  const Run* run = FindRun(runs, label);
+  if (run == nullptr) throw std::logic_error("recognize_bench: no run labelled '" + label + "'");
+  return *run;
+}
+
+// The runs on the frames with one library.
+struct LibraryRuns {
+  std::string name;  // "ycbv.sqlite (7 models)"
+  Runs runs;         // in column order
+};
+
+using ObjectFilter = std::function<bool(const FrameEvaluation&, const ObjectEvaluation&)>;
+
+// "correct / present" over the objects of `run` that `counted` keeps; with the recall in per cent if `recall`.
+std::string CountObjects(const Run& run, const ObjectFilter& counted, bool recall = false) {
+  int correct = 0, present = 0;
+  for (const FrameEvaluation& frame : run.frames) {
+    for (const ObjectEvaluation& object : frame.objects) {
+      if (!counted(frame, object)) continue;
+      correct += object.correct ? 1 : 0;
+      ++present;
+    }
+  }
+  const std::string count = std::to_string(correct) + " / " + std::to_string(present);
+  return recall ? count + " (" + Fixed(100.0 * correct / std::max(present, 1), 1) + " %)" : count;
+}
+
+// The video of a frame: the part of its name before '/'.
+std::string VideoOf(const std::string& frame) {
+  return frame.substr(0, frame.find('/'));
+}
+
+// The median or mean of the run's whole-frame times, in ms; "-" without them.
+std::string FrameMs(const Run& run, bool median) {
+  const auto total = run.stage_ms.find("total");
+  if (total == run.stage_ms.end()) return "-";
+  return Fixed(median ? Median(total->second) : Mean(total->second), 0);
+}
+
+// A table row: `name`, then `cell` of the run of each of `columns` in `runs` ("-" where `runs` has none).
+std::string TableRow(const std::string& name, const Runs& runs, const std::vector<std::string>& columns,
+                     const std::function<std::string(const Run&)>& cell) {
+  std::string row = "| " + name + " |";
+  for (const std::string& label : columns) {
+    const Run* run = FindRun(runs, label);
+    row += ' ' + (run != nullptr ? cell(*run) : std::string("-")) + " |";
+  }
+  return row + '\n';
+}
+
+// The recall table's rows of one library's `runs`: per object correct / present; then recall (overall and per video,
+// when there are several), false positives and the time per frame.
+std::string RecallRows(const Runs& runs, const std::vector<std::string>& columns) {
+  std::set<std::string> objects, videos;
   for (const auto& [label, run] : runs) {
     for (const FrameEvaluation& frame : run.frames) {
-      false_positives[label] += frame.false_positives;
-      for (const ObjectEvaluation& object : frame.objects) {
-        auto& [correct, present] = counts[object.model][label];
-        correct += object.correct ? 1 : 0;
-        ++present;
-      }
+      videos.insert(VideoOf(frame.frame));
+      for (const ObjectEvaluation& object : frame.objects) objects.insert(object.model);
+    }
+  }
+  std::string rows;
+  for (const std::string& name : objects) {
+    rows += TableRow(name, runs, columns, [&](const Run& run) {
+      return CountObjects(run, [&](const FrameEvaluation&, const ObjectEvaluation& o) { return o.model == name; });
+    });
+  }
+  rows += TableRow("**all (recall)**", runs, columns, [](const Run& run) {
+    return "**" +
+           CountObjects(
+               run, [](const FrameEvaluation&, const ObjectEvaluation&) { return true; }, true) +
+           "**";
+  });
+  for (const std::string& video : videos.size() > 1 ? videos : std::set<std::string>{}) {
+    rows += TableRow("video " + video, runs, columns, [&](const Run& run) {
+      return CountObjects(run,
+                          [&](const FrameEvaluation& f, const ObjectEvaluation&) { return VideoOf(f.frame) == video; });
+    });
+  }
+  rows += TableRow("false positives per frame", runs, columns, [](const Run& run) {
+    int false_positives = 0;
+    for (const FrameEvaluation& frame : run.frames) false_positives += frame.false_positives;
+    return Fixed(static_cast<double>(false_positives) / std::max<size_t>(run.frames.size(), 1), 2);
+  });
+  rows += TableRow("false positives followed from an earlier frame", runs, columns,
+                   [](const Run& run) { return std::to_string(FollowedFalsePositives(run)); });
+  rows += TableRow("median ms per frame", runs, columns, [](const Run& run) { return FrameMs(run, true); });
+  rows += TableRow("mean ms per frame", runs, columns, [](const Run& run) { return FrameMs(run, false); });
+  return rows;
+}
+
+// A column per run (each label once, in the order they ran); the rows of RecallRows per library, under a row naming
+// the library when there are several.
+std::string RecallTable(const std::vector<LibraryRuns>& libraries) {
+  std::vector<std::string> columns;
+  for (const LibraryRuns& library : libraries) {
+    for (const auto& [label, run] : library.runs) {
+      if (std::find(columns.begin(), columns.end(), label) == columns.end()) columns.push_back(label);
     }
   }
   std::ostringstream out;
   out << "| object |";
-  for (const auto& [label, run] : runs) out << ' ' << label << " |";
+  for (const std::string& label : columns) out << ' ' << label << " |";
   out << "\n|---|";
-  for (size_t i = 0; i < runs.size(); ++i) out << "---:|";
+  for (size_t i = 0; i < columns.size(); ++i) out << "---:|";
   out << '\n';
-  std::map<std::string, std::pair<int, int>> totals;
-  for (const auto& [object, per_run] : counts) {
-    out << "| " << object << " |";
-    for (const auto& [label, run] : runs) {
-      const auto [correct, present] = per_run.at(label);
-      totals[label].first += correct;
-      totals[label].second += present;
-      out << ' ' << correct << " / " << present << " |";
+  for (const LibraryRuns& library : libraries) {
+    if (libraries.size() > 1) {
+      out << "| **" << library.name << "** |";
+      for (size_t i = 0; i < columns.size(); ++i) out << " |";
+      out << '\n';
     }
-    out << '\n';
+    out << RecallRows(library.runs, columns);
   }
-  out << "| **all (recall)** |";
-  for (const auto& [label, run] : runs) {
-    const auto [correct, present] = totals[label];
-    out << " **" << correct << " / " << present << " (" << Fixed(100.0 * correct / std::max(present, 1), 1)
-        << " %)** |";
-  }
-  // Recall per video (the part of a frame's name before '/'), when there are several.
-  std::map<std::string, std::map<std::string, std::pair<int, int>>> videos;  // video -> run -> (correct, present)
-  for (const auto& [label, run] : runs) {
-    for (const FrameEvaluation& frame : run.frames) {
-      auto& [correct, present] = videos[frame.frame.substr(0, frame.frame.find('/'))][label];
-      for (const ObjectEvaluation& object : frame.objects) {
-        correct += object.correct ? 1 : 0;
-        ++present;
-      }
-    }
-  }
-  for (const auto& [video, per_run] : videos) {
-    if (videos.size() < 2) break;
-    out << "\n| video " << video << " |";
-    for (const auto& [label, run] : runs)
-      out << ' ' << per_run.at(label).first << " / " << per_run.at(label).second << " |";
-  }
-  out << "\n| false positives per frame |";
-  for (const auto& [label, run] : runs) {
-    out << ' ' << Fixed(static_cast<double>(false_positives[label]) / std::max<size_t>(run.frames.size(), 1), 2)
-        << " |";
-  }
-  out << "\n| false positives followed from an earlier frame |";
-  for (const auto& [label, run] : runs) out << ' ' << FollowedFalsePositives(run) << " |";
-  for (const bool median : {true, false}) {
-    out << (median ? "\n| median ms per frame |" : "\n| mean ms per frame |");
-    for (const auto& [label, run] : runs) {
-      const auto total = run.stage_ms.find("total");
-      out << ' '
-          << (total == run.stage_ms.end() ? std::string("-")
-                                          : Fixed(median ? Median(total->second) : Mean(total->second), 0))
-          << " |";
-    }
-  }
-  out << '\n';
   return out.str();
 }
 
-std::string TimingTable(const Run& run) {
+// The time per stage of the run labelled `label` (ms per frame). With several libraries: the stages of the first
+// library's run, then one row per library with its time per frame and its median over the first library's.
+std::string TimingTable(const std::vector<LibraryRuns>& libraries, const std::string& label) {
+  const bool several = libraries.size() > 1;
   std::ostringstream out;
-  out << "| stage | median ms per frame | mean ms per frame |\n|---|---:|---:|\n";
+  out << "| stage | median ms per frame | mean ms per frame |" << (several ? " median / first library's |" : "")
+      << "\n|---|---:|---:|" << (several ? "---:|" : "") << '\n';
+  const Run& first = RunNamed(libraries.front().runs, label);
   for (const char* stage : {"extract", "describe", "track", "preselect", "rank", "match", "ransac", "point_pairs",
                             "verify", "refine", "total"}) {
-    const auto found = run.stage_ms.find(stage);
-    if (found != run.stage_ms.end()) {
-      out << "| " << stage << " | " << Fixed(Median(found->second), 1) << " | " << Fixed(Mean(found->second), 1)
-          << " |\n";
-    }
+    const auto found = first.stage_ms.find(stage);
+    if (found == first.stage_ms.end() || (several && found->first == "total")) continue;
+    out << "| " << stage << " | " << Fixed(Median(found->second), 1) << " | " << Fixed(Mean(found->second), 1)
+        << (several ? " | |\n" : " |\n");
+  }
+  const double first_median = Median(first.stage_ms.at("total"));
+  for (const LibraryRuns& library : several ? libraries : std::vector<LibraryRuns>{}) {
+    const std::vector<double>& total = RunNamed(library.runs, label).stage_ms.at("total");
+    out << "| total, " << library.name << " | " << Fixed(Median(total), 1) << " | " << Fixed(Mean(total), 1) << " | "
+        << Fixed(Median(total) / std::max(first_median, 1e-9), 2) << " |\n";
   }
   return out.str();
 }
@@ -372,11 +436,6 @@ std::string TrackingEvery(int n) {
   return std::string(kTracking) + ", full search every " + std::to_string(n) + " frames";
 }
 
-// The run labelled `name` (it must be there).
-const Run& RunNamed(const Runs& runs, const std::string& name) {
-  return std::find_if(runs.begin(), runs.end(), [&](const auto& run) { return run.first == name; })->second;
-}
-
 // Which methods RunAll runs.
 struct Methods {
   bool ours = true;                         ///< ECV with and without ICP
@@ -398,8 +457,8 @@ struct Methods {
 };
 
 // The `methods` on `frames` with the library at `db`.
-Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const Methods& methods,
-            const PeerOptions& peer_options, std::ostringstream* notes) {
+LibraryRuns RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const Methods& methods,
+                   const PeerOptions& peer_options, std::ostringstream* notes) {
   LibraryLoadOptions load;
   load.build_matchers = false;
   const ModelLibrary library = ModelLibrary::Load(db, load);
@@ -409,7 +468,9 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
          << std::count_if(library.models().begin(), library.models().end(),
                           [](const LibraryModel& model) { return model.color_matrix.has_value(); })
          << ". ";
-  Runs runs;
+  LibraryRuns result{
+      std::filesystem::path(db).filename().string() + " (" + std::to_string(library.models().size()) + " models)", {}};
+  Runs& runs = result.runs;
   RecognizerOptions options = methods.options;
   // A run of `settings` on `run_frames` labelled `label`, then one more per --seeds seed, labelled ", seed N".
   const auto add_seeded = [&](const std::string& label, RecognizerOptions settings,
@@ -497,7 +558,7 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
     options.refine = false;
     runs.emplace_back("ECV + RANSAC (no ICP)", RunRecognizer(library, options, frames, models, "no icp"));
   }
-  if (!methods.peers) return runs;
+  if (!methods.peers) return result;
   std::vector<PeerModel> peer_models;
   for (const LibraryModel& model : library.models()) peer_models.push_back(SamplePeerModel(model.record));
   *notes << GroundTruthInlierShares(peer_models, frames, peer_options);
@@ -538,7 +599,26 @@ Runs RunAll(const std::string& db, const std::vector<NamedFrame>& frames, const 
          << " ms (PCL), " << Fixed(Median(ppf_run.stage_ms.at("scene")), 0) << " ms (OpenCV)";
   if (open3d) *notes << ", " << Fixed(Median(RunNamed(runs, kOpen3d).stage_ms.at("scene")), 0) << " ms (Open3D)";
   *notes << " per frame. ";
-  return runs;
+  return result;
+}
+
+// The runs of ours with each library of `dbs`, in turn; the peers with the first only.
+std::vector<LibraryRuns> RunLibraries(const std::vector<std::string>& dbs, const std::vector<NamedFrame>& frames,
+                                      const Methods& methods, const PeerOptions& peer_options,
+                                      std::ostringstream* notes) {
+  std::vector<LibraryRuns> libraries;
+  Methods per_library = methods;
+  for (const std::string& db : dbs) {
+    if (!libraries.empty() && !methods.ours) break;
+    libraries.push_back(RunAll(db, frames, per_library, peer_options, notes));
+    per_library.peers = false;
+  }
+  if (libraries.size() > 1) {
+    *notes << "Every run of ours with each library; the peers with the first. The recall table has the rows of each "
+              "library under its name (a library is judged on the objects of the frames that it holds); each time "
+              "table the stages with the first library, then a row per library with its median over the first's. ";
+  }
+  return libraries;
 }
 
 // One picture of frame `name` per run of `labels` (those that ran), 2 per row, each with the run's detections
@@ -625,7 +705,8 @@ std::string PeerSettings(const PeerOptions& o) {
 int main(int argc, char** argv) {
   using namespace ecv;
   using namespace ecv::bench;
-  std::string db, lmo_db, figure, results = std::string(ECV_SOURCE_DIR) + "/bench/RESULTS.md";
+  std::vector<std::string> dbs;
+  std::string lmo_db, figure, results = std::string(ECV_SOURCE_DIR) + "/bench/RESULTS.md";
   int limit = 0, step = 1;
   Methods methods;
   PeerOptions peer_options;
@@ -634,7 +715,10 @@ int main(int argc, char** argv) {
       "ground truth (recall at ADD < 0.1 d, false positives) with the time per stage; PCL, OpenCV PPF and "
       "Open3D as peers.",
       "recognize_bench"};
-  app.add_option("--db", db, "Library of the YCB-Video models")->required();
+  app.add_option("--db", dbs,
+                 "Library of the YCB-Video models; repeated, every run of ours with each library in turn (ratios "
+                 "between library sizes from one run); the peers and --figure with the first")
+      ->required();
   app.add_option("--lmo-db", lmo_db,
                  "Library of the LM-O models: also the LM-O frame, as its own table (default: not run)");
   app.add_flag("--peers", methods.peers, "Also run the peers (PCL, OpenCV PPF, Open3D) on the same frames");
@@ -707,55 +791,56 @@ int main(int argc, char** argv) {
     peer_options.Check();
     std::ostringstream markdown, notes;
     const std::vector<NamedFrame> frames = YcbvFrames(ECV_DATA_DIR, limit, step);
-    const Runs runs = RunAll(db, frames, methods, peer_options, &notes);
+    const std::vector<LibraryRuns> libraries = RunLibraries(dbs, frames, methods, peer_options, &notes);
     if (!figure.empty()) {
-      WriteColorImage(figure, DetectionsFigure(db, frames, runs, kFigureFrame, {kOurs, kOpen3d, kPcl, kPpf}));
+      WriteColorImage(figure, DetectionsFigure(dbs.front(), frames, libraries.front().runs, kFigureFrame,
+                                               {kOurs, kOpen3d, kPcl, kPpf}));
       std::cerr << "recognize_bench: wrote " << figure << '\n';
     }
     markdown << notes.str() << frames.size()
              << " YCB-Video frames (videos 0000-0002). Correct = ADD < 0.1 x diameter (ADD-S for symmetric models); "
                 "a false positive is a detection of a model not in the frame or a wrong pose.\n\n"
-             << RecallTable(runs);
+             << RecallTable(libraries);
     if (methods.ours)
-      markdown << "\nTime per frame, whole library (ECV + RANSAC + ICP):\n\n" << TimingTable(runs.front().second);
+      markdown << "\nTime per frame, whole library (ECV + RANSAC + ICP):\n\n" << TimingTable(libraries, kOurs);
     for (const std::string& source : methods.ours ? methods.hypotheses : std::vector<std::string>{}) {
       markdown << "\nThe same with `--hypotheses " << source << "` (point_pairs: voting; verify and refine include the "
                << "point pair poses'):\n\n"
-               << TimingTable(RunNamed(runs, std::string(kOurs) + ", --hypotheses " + source));
+               << TimingTable(libraries, std::string(kOurs) + ", --hypotheses " + source);
     }
     if (methods.ours && methods.bytes) {
       markdown << "\nThe same matching with ByteNeighbours (`recognize --matcher bytes`: every scene descriptor "
                   "compared over 7-bit values, AVX-512 VNNI):\n\n"
-               << TimingTable(RunNamed(runs, kBytes));
+               << TimingTable(libraries, kBytes);
     }
     for (const int preselect : methods.ours ? methods.preselect : std::vector<int>{}) {
       if (preselect <= 0) continue;
       markdown << "\nThe same searching only the " << preselect
                << " models that a quick look scores best (`recognize --preselect " << preselect << "`):\n\n"
-               << TimingTable(RunNamed(runs, Preselecting(preselect)));
+               << TimingTable(libraries, Preselecting(preselect));
     }
     if (methods.ours && methods.track) {
       markdown << "\nThe same with tracking (each frame gets the previous frame's detections of its video as priors; "
                   "the first frame of each video has none):\n\n"
-               << TimingTable(RunNamed(runs, kTracking));
+               << TimingTable(libraries, kTracking);
       for (const int every : methods.search_every) {
         if (every <= 1) continue;
         markdown << "\nTracking with a full search only on the first frame of each video and then once every " << every
                  << " frames; the frames in between follow the tracked objects and search only the models whose "
                     "track was lost (`recognize --track --search-every "
                  << every << "`):\n\n"
-                 << TimingTable(RunNamed(runs, TrackingEvery(every)));
+                 << TimingTable(libraries, TrackingEvery(every));
       }
     }
     if (!lmo_db.empty()) {
       std::ostringstream lmo_notes;
       Methods lmo_methods = methods;
       lmo_methods.track = false;  // one frame
-      const Runs lmo_runs = RunAll(lmo_db, LmoFrames(ECV_DATA_DIR), lmo_methods, peer_options, &lmo_notes);
+      const LibraryRuns lmo_runs = RunAll(lmo_db, LmoFrames(ECV_DATA_DIR), lmo_methods, peer_options, &lmo_notes);
       markdown << "\nLinemod-Occluded, scene 000002 image 3 (Kinect v1, 8 vertex-coloured models, eggbox and glue "
                   "judged by ADD-S). "
                << lmo_notes.str() << "\n\n"
-               << RecallTable(lmo_runs);
+               << RecallTable({lmo_runs});
     }
     if (methods.peers) markdown << '\n' << PeerSettings(peer_options);
     ReportSection(results, "Recognition on YCB-Video and LM-O (recognize_bench)", CommandLine(argc, argv),
