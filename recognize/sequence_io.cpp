@@ -2,6 +2,8 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <poll.h>
+#include <sys/inotify.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -47,7 +49,30 @@ FrameFeed::FrameFeed(const std::string& sequence, bool follow, double idle_timeo
   if (!IsDirectory(sequence)) {
     ThrowInputError(sequence, "--follow", "a folder that frame JSONs are written into", "no such folder");
   }
+  watch_fd_ = inotify_init1(IN_NONBLOCK | IN_CLOEXEC);
+  if (watch_fd_ >= 0 && inotify_add_watch(watch_fd_, sequence.c_str(), IN_CLOSE_WRITE | IN_MOVED_TO) < 0) {
+    close(watch_fd_);
+    watch_fd_ = -1;
+  }
   Scan();
+}
+
+FrameFeed::~FrameFeed() {
+  if (watch_fd_ >= 0) close(watch_fd_);
+}
+
+void FrameFeed::Wait(std::chrono::duration<double> most) {
+  const auto most_ms = std::chrono::duration_cast<std::chrono::milliseconds>(most).count();
+  if (watch_fd_ < 0) {  // no inotify (another file system, say): the folder is looked at every 10 ms
+    std::this_thread::sleep_for(std::chrono::milliseconds(std::min<long long>(10, most_ms)));
+    return;
+  }
+  pollfd watch{watch_fd_, POLLIN, 0};
+  if (poll(&watch, 1, static_cast<int>(std::min<long long>(most_ms, 1000))) > 0) {
+    char events[4096];
+    while (read(watch_fd_, events, sizeof events) > 0) {
+    }
+  }
 }
 
 void FrameFeed::Scan() {
@@ -64,8 +89,10 @@ void FrameFeed::Scan() {
 std::optional<std::string> FrameFeed::Next() {
   if (follow_ && next_ == frames_.size()) {
     const auto since = std::chrono::steady_clock::now();
-    while (next_ == frames_.size() && std::chrono::steady_clock::now() - since < idle_timeout_) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    while (next_ == frames_.size()) {
+      const auto waited = std::chrono::steady_clock::now() - since;
+      if (waited >= idle_timeout_) break;
+      Wait(idle_timeout_ - waited);
       Scan();
     }
   }

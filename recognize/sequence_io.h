@@ -41,6 +41,9 @@ class LineOutput {
 class FrameFeed : public FrameSource {
  public:
   FrameFeed(const std::string& sequence, bool follow, double idle_timeout_s);
+  ~FrameFeed() override;
+  FrameFeed(const FrameFeed&) = delete;
+  FrameFeed& operator=(const FrameFeed&) = delete;
 
   /// The next frame's file (FRAME); nothing at the end.
   std::optional<std::string> Next() override;
@@ -52,7 +55,8 @@ class FrameFeed : public FrameSource {
   std::string Counter() const override;
 
  private:
-  void Scan();  // adds the folder's frame JSONs not seen yet, in name order
+  void Scan();                                    // adds the folder's frame JSONs not seen yet, in name order
+  void Wait(std::chrono::duration<double> most);  // until a file lands in the folder (inotify), or `most` passes
 
   std::string folder_;
   bool follow_;
@@ -60,6 +64,7 @@ class FrameFeed : public FrameSource {
   std::vector<std::string> frames_;
   size_t next_ = 0;
   std::set<std::string> seen_;
+  int watch_fd_ = -1;  // with `follow`: inotify on the folder's finished and moved-in files; -1: polled
 };
 
 }  // namespace ecv::app

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <Eigen/Dense>
 
@@ -65,6 +66,8 @@ Eigen::Isometry3d Increment(const Eigen::Matrix<double, 6, 1>& step) {
 // fewer than 6 pairs or no finite solution.
 template <typename Pair>
 void Iterate(size_t object_count, const IcpOptions& options, IcpResult* result, Pair pair) {
+  double best_rmse_m = std::numeric_limits<double>::infinity();
+  int stalled = 0;  // small steps in a row since the residual last fell by plateau_ratio
   for (result->iterations = 1; result->iterations <= options.max_iterations; ++result->iterations) {
     PointToPlaneSystem system;
     pair(result->scene_from_object.cast<float>(), &system);
@@ -73,6 +76,15 @@ void Iterate(size_t object_count, const IcpOptions& options, IcpResult* result, 
     if (system.count < 6) return;
     const Eigen::Matrix<double, 6, 1> step = system.normal_matrix.ldlt().solve(-system.gradient);
     if (!step.allFinite()) return;
+    const bool small =
+        step.head<3>().norm() < options.plateau_step_rad && step.tail<3>().norm() < options.plateau_step_m;
+    if (result->rmse_m < (1.0 - options.plateau_ratio) * best_rmse_m) {
+      best_rmse_m = result->rmse_m;
+      stalled = 0;
+    } else {
+      stalled = small ? stalled + 1 : 0;
+    }
+    if (options.plateau_iterations > 0 && stalled >= options.plateau_iterations) break;
     result->scene_from_object = Increment(step) * result->scene_from_object;
     result->success = true;
     if (step.head<3>().norm() < options.convergence_rotation_rad &&
@@ -93,6 +105,9 @@ void IcpOptions::Check() const {
   require(max_correspondence_m > 0.0 && std::isfinite(max_correspondence_m), "max_correspondence_m", "> 0 m");
   require(convergence_translation_m >= 0.0 && convergence_rotation_rad >= 0.0, "convergence", ">= 0");
   require(normal_neighbours >= 3, "normal_neighbours", "at least 3");
+  require(plateau_iterations >= 0, "plateau_iterations", ">= 0 (0: never)");
+  require(plateau_ratio >= 0.0 && plateau_ratio < 1.0, "plateau_ratio", "in [0, 1)");
+  require(plateau_step_m >= 0.0 && plateau_step_rad >= 0.0, "plateau_step", ">= 0");
 }
 
 IcpResult RefinePointToPlane(const std::vector<Eigen::Vector3f>& object_points,

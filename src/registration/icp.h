@@ -13,9 +13,17 @@ namespace ecv {
 struct IcpOptions {
   int max_iterations = 30;                  ///< Gauss-Newton steps at most
   double max_correspondence_m = 0.01;       ///< object points farther than this from the scene are ignored, metres
-  double convergence_translation_m = 1e-5;  ///< stop when a step moves less than this, metres ...
-  double convergence_rotation_rad = 1e-5;   ///< ... and turns less than this, radians
+  double convergence_translation_m = 1e-4;  ///< stop when a step moves less than this, metres ...
+  double convergence_rotation_rad = 1e-4;   ///< ... and turns less than this, radians
   int normal_neighbours = 10;               ///< scene normals from this many nearest points (PCA)
+  /// Stop after this many small steps in a row (each under plateau_step_m and plateau_step_rad) that did not lower the
+  /// RMS residual by plateau_ratio (relative; 0: never stop so): the pairs then only cycle, or the pose slides along a
+  /// direction the surface leaves free (a cylinder's axis). Large steps go on: a pose far off may get worse before it
+  /// gets better.
+  int plateau_iterations = 3;
+  double plateau_ratio = 0.005;
+  double plateau_step_m = 0.001;
+  double plateau_step_rad = 0.001;
 
   void Check() const;
 };

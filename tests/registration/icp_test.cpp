@@ -168,6 +168,43 @@ TEST(Icp, OrganizedSceneNormalsOfARealTableAndMissingDepth) {
   EXPECT_THROW(MakeOrganizedScene(cv::Mat(10, 10, CV_32FC1), loaded.rgbd.camera, 2), InputError);
 }
 
+TEST(Icp, StopsOnceTheResidualNoLongerFallsOnACylinder) {
+  // Half a can's side (radius 3.3 cm, 10 cm tall) seen with 1 mm depth noise: turning about its axis and sliding along
+  // it change nothing, so once the side is fitted the residual stays at the noise and ICP stops.
+  std::mt19937 random(2);
+  std::uniform_real_distribution<float> angle(0.0F, static_cast<float>(M_PI)), height(0.0F, 0.1F);
+  std::normal_distribution<float> noise(0.0F, 0.001F);
+  constexpr float kRadius = 0.033F;
+  std::vector<Eigen::Vector3f> object, scene;
+  const Eigen::Isometry3d truth = Perturbation(0.5, 0.8);
+  for (int i = 0; i < 3000; ++i) {
+    const float a = angle(random);
+    const Eigen::Vector3f radial(std::cos(a), std::sin(a), 0.0F);
+    const Eigen::Vector3f p = kRadius * radial + Eigen::Vector3f(0.0F, 0.0F, height(random));
+    object.push_back(p);
+    scene.push_back(truth.cast<float>() * (p + noise(random) * radial));
+  }
+  const Eigen::Isometry3d initial = truth * Perturbation(3.0 * kDegree, 0.003);
+  IcpOptions never = {};  // no plateau, and steps down to a micrometre
+  never.plateau_iterations = 0;
+  never.convergence_translation_m = never.convergence_rotation_rad = 1e-6;
+  const IcpResult stopped = RefinePointToPlane(object, scene, initial);
+  const IcpResult full = RefinePointToPlane(object, scene, initial, never);
+  ASSERT_TRUE(stopped.success);
+  ASSERT_TRUE(full.success);
+  EXPECT_LT(stopped.iterations, full.iterations);
+  EXPECT_LT(stopped.iterations, 15);
+  EXPECT_LT(stopped.rmse_m, 1.05 * full.rmse_m);
+  // The axis is where it belongs: its direction within 1 degree, its points within 1 mm of the true axis.
+  const Eigen::Vector3d axis = stopped.scene_from_object.linear().col(2), true_axis = truth.linear().col(2);
+  EXPECT_LT(std::acos(std::min(1.0, std::abs(axis.dot(true_axis)))), 1.0 * kDegree);
+  for (const double z : {0.0, 0.1}) {
+    const Eigen::Vector3d on_axis = stopped.scene_from_object * Eigen::Vector3d(0.0, 0.0, z);
+    const Eigen::Vector3d offset = on_axis - truth.translation();
+    EXPECT_LT((offset - offset.dot(true_axis) * true_axis).norm(), 0.001) << "at z = " << z;
+  }
+}
+
 TEST(Icp, TooFewPointsIsAFailedResult) {
   const std::vector<Eigen::Vector3f> few = {{0, 0, 1}, {0.1F, 0, 1}};
   EXPECT_FALSE(RefinePointToPlane(few, few, Eigen::Isometry3d::Identity()).success);
