@@ -355,7 +355,7 @@ int Main(int argc, char** argv) {
                  "JSON Lines file every run's detections are appended to, per frame with their verification terms "
                  "and which were right, with each found or wrongly placed object's pose errors");
   s.recognizer.options.ransac.threads = 2;  // the benchmark machine's cores
-  AddSettingFlags(app, &s.recognizer, {"hypotheses", "track"},
+  AddSettingFlags(app, &s.recognizer, {"hypotheses", "track", "search-beside"},
                   "Settings of every run (as `ecvpose recognize` takes them)");
   if (const auto exit_code = ParseCommandLine(app, argc, argv)) return *exit_code;
   if (s.hypotheses.empty()) s.hypotheses = {HypothesisSourceName(s.recognizer.options.point_pairs.source)};

@@ -779,7 +779,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   RecognizerSettings settings;  // every run of ours: the table's flags but those above, which add runs
   AddSettingFlags(app, &settings,
-                  {"threads", "preselect", "hypotheses", "track", "search-every", "confirm-every", "confirm-first"},
+                  {"threads", "preselect", "hypotheses", "track", "search-every", "search-beside", "confirm-every",
+                   "confirm-first"},
                   "Settings of every run of ours (as `ecvpose recognize` takes them)");
   app.footer(
       "Libraries:\n  scripts/build_ycbv_library YCBV_LIB.sqlite --views 40 --distance 0.9\n"

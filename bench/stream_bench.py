@@ -6,7 +6,8 @@
         [--runs follow serve] [--frames-limit N] [--drain 10] [--cli build/src/app/ecvpose] [--results FILE]
 
 Each configuration's FLAGS go to both commands (default: "track" = --track, "search every 3" = --track
---search-every 3); `recognize` also gets --follow --track --out-json -, and every serve request "track": true. Latency
+--search-every 3, "search beside" = --track --search-beside); `recognize` also gets --follow --track --out-json -,
+and every serve request "track": true. Latency
 of a frame: `recognize`, from its frame JSON appearing (renamed into DIR) to its result line on standard output;
 `serve`, from the time its request was due to its answer. Frames wait in turn when the recognizer is slower than the
 camera, and the wait counts. Feeding stops after --seconds (or --frames-limit frames); frames not answered --drain
@@ -36,7 +37,8 @@ sys.path.insert(0, str(HERE))
 from bench_util import report  # noqa: E402
 
 TITLE = "Stream latency at camera rate: recognize --follow and serve (stream_bench.py)"
-DEFAULT_CONFIGS = [("track", "--track"), ("search every 3", "--track --search-every 3")]
+DEFAULT_CONFIGS = [("track", "--track"), ("search every 3", "--track --search-every 3"),
+                   ("search beside", "--track --search-beside")]
 SEARCH_STAGES = ("rank", "ransac", "point_pairs")  # timings_ms keys of a frame in which models were searched
 YCBV_DEPTH_SCALE = 10000  # depth PNG units per metre of YCB-Video (checked against its meta files below)
 START_TIMEOUT_S = 300  # for a library and its meshes to load
@@ -333,7 +335,7 @@ def summary(streams):
                 continue
             timings = answer.get("timings_ms", {})
             totals.append(timings.get("total", 0.0))
-            searched += any(stage in timings for stage in SEARCH_STAGES)
+            searched += any(stage in timings for stage in SEARCH_STAGES) or "searched_frames_ago" in answer
             objects.append(len(answer.get("detections", [])))
     answered = len(totals) + errors
     cells = [str(fed), str(answered) + (f" ({errors} errors)" if errors else "")]
@@ -444,7 +446,8 @@ def main():
              f"standard input, latency from when the request was due to its answer. Frames queue when the recognizer "
              f"is slower than the camera, and the wait counts; frames still unanswered {args.drain:g} s after the "
              f"last was due count with the time they had waited (≥: a percentile they may raise). Searched: the "
-             f"answered frames in which models were searched (timings_ms has rank, ransac or point_pairs). The feed "
+             f"answered frames in which models were searched (timings_ms has rank, ransac or point_pairs), or that a "
+             f"search beside the tracking joined (searched_frames_ago). The feed "
              f"was at most {late_ms:.1f} ms late. Configurations: "
              + "; ".join(f"{name}: `{shlex.join(flags)}`" for name, flags in configs) + ".", "",
              "| configuration | run | video | frames fed | answered | latency p50 ms | p95 ms | p99 ms | searched | "

@@ -26,10 +26,12 @@ nlohmann::json RecognitionToJson(const RecognitionResult& result) {
                           {"confirmed", d.confirmed},
                           {"hypothesis", HypothesisSourceName(d.hypothesis)}});
   }
-  return {{"detections", detections},
-          {"timings_ms", result.timings_ms},
-          {"scene_primitives", result.scene_primitives},
-          {"views_tried", result.views_tried}};
+  nlohmann::json json = {{"detections", detections},
+                         {"timings_ms", result.timings_ms},
+                         {"scene_primitives", result.scene_primitives},
+                         {"views_tried", result.views_tried}};
+  if (result.searched_frames_ago >= 0) json["searched_frames_ago"] = result.searched_frames_ago;
+  return json;
 }
 
 std::vector<Detection> DetectionsFromJson(const nlohmann::json& json, const std::string& source) {

@@ -33,12 +33,12 @@ void CheckReadable(const FrameSpec& spec, const ReadRoots& roots) {
 }  // namespace
 
 RecognitionService::RecognitionService(Recognizer& recognizer, const StreamOptions& stream, const RequestLimits& limits,
-                                       ReadRoots roots)
+                                       ReadRoots roots, RecognizerFactory make_searcher)
     : recognizer_(recognizer),
       track_by_default_(stream.track),
       limits_(limits),
       roots_(std::move(roots)),
-      stream_(recognizer, Tracking(stream)) {
+      stream_(recognizer, Tracking(stream), std::move(make_searcher)) {
   limits_.Check();
 }
 
@@ -48,6 +48,8 @@ nlohmann::json RecognitionService::Handle(const std::string& line) {
     ParseRequest(line, limits_, &request);
     return Respond(request);
   } catch (const InputError& error) {
+    return ErrorResponse(request.id, error.what());
+  } catch (const BackgroundSearchError& error) {  // the stream has started again
     return ErrorResponse(request.id, error.what());
   } catch (const std::bad_alloc&) {  // the request's, not the service's: the next one is answered
     stream_.Reset();

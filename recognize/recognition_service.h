@@ -26,8 +26,11 @@ class RecognitionService {
  public:
   /// `recognizer` must outlive the service. `stream`: whether requests track by default, and the search schedule
   /// of tracked requests. `roots`: where frames may be read (default: anywhere, FIFOs, devices and folders aside).
+  /// With stream.search_beside, `make_searcher` makes the recognizer that searches beside the tracked requests (on a
+  /// thread of the service's own, from its first tracked request); a failure of that thread is the error response
+  /// of the next tracked request, and the tracks start again.
   RecognitionService(Recognizer& recognizer, const StreamOptions& stream, const RequestLimits& limits = {},
-                     ReadRoots roots = {});
+                     ReadRoots roots = {}, RecognizerFactory make_searcher = {});
 
   /// The response to one request line.
   nlohmann::json Handle(const std::string& line);

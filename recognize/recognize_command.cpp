@@ -74,7 +74,12 @@ void AppendBopRows(std::ostream& out, std::pair<int, int> ids, const Recognition
 
 void PrintDetections(std::ostream& out, const LoadedFrame& loaded, const RecognitionResult& result) {
   out << std::fixed << std::setprecision(2) << loaded.rgbd.name << ": " << result.detections.size() << " detections ("
-      << result.scene_primitives << " scene primitives)\n";
+      << result.scene_primitives << " scene primitives";
+  if (result.searched_frames_ago >= 0) {
+    out << "; joined by the search of " << result.searched_frames_ago
+        << (result.searched_frames_ago == 1 ? " frame" : " frames") << " before";
+  }
+  out << ")\n";
   for (const Detection& d : result.detections) {
     out << "  " << std::left << std::setw(24) << d.model << std::right << " score " << d.score << " (depth "
         << d.depth_agreement << ", colour " << d.color_agreement << ", edges " << d.edge_agreement << " of "
@@ -107,6 +112,9 @@ RecognizerOptions OptionsFromArgs(const RecognizeArgs& args) {
   }
   if (args.recognizer.stream.search_every > 1 && !args.recognizer.stream.track) {
     ThrowInputError("recognize", "--search-every", "--track as well");
+  }
+  if (args.recognizer.stream.search_beside && !args.recognizer.stream.track) {
+    ThrowInputError("recognize", "--search-beside", "--track as well");
   }
   return options;
 }
@@ -146,15 +154,15 @@ std::string OverlayPath(const std::string& directory, int number) {
 
 // A sequence, processed in order as a camera stream would arrive; a broken frame is reported and skipped. Each
 // frame's JSON line and BOP rows are written as soon as it is done.
-int RecognizeSequence(const RecognizeArgs& args, FrameSource& feed, const ModelLibrary& library,
-                      Recognizer& recognizer) {
+int RecognizeSequence(const RecognizeArgs& args, FrameSource& feed, const ModelLibrary& library, Recognizer& recognizer,
+                      const RecognizerOptions& search_options) {
   std::ostream& report = Report(args);
   LineOutput lines(args.out_json, "--out-json"), csv(args.out_bop, "--out-bop");
   if (csv.active()) csv.Write(kBopHeader);
   const std::map<std::string, int> object_ids = BopObjectIds(library);
   int done = 0, failed = 0;
   double total_ms = 0.0;
-  RecognitionStream stream(recognizer, args.recognizer.stream);
+  RecognitionStream stream(recognizer, args.recognizer.stream, MakeRecognizerFactory(library, search_options));
   if (!args.overlay.empty()) std::filesystem::create_directories(args.overlay);
   while (const std::optional<std::string> frame = feed.Next()) {
     try {
@@ -217,16 +225,16 @@ int RunRecognize(const RecognizeArgs& args, const FrameSourceOpener& open_live) 
     std::cerr << "ecvpose recognize: --follow needs --sequence FOLDER\n";
     return kExitBadUsage;
   }
-  const RecognizerOptions options = OptionsFromArgs(args);
+  const StreamRecognizerOptions options = ShareThreads(OptionsFromArgs(args), args.recognizer.stream);
   std::unique_ptr<FrameSource> feed;
   if (!args.sequence.empty()) feed = OpenSequence(args, open_live);
   // One frame is read first: a broken one is reported before the library and its meshes (seconds) are loaded.
   std::optional<LoadedFrame> single;
   if (!feed) single.emplace(app::LoadFrameWithWarnings(args.frame));
-  const LoadedRecognizer loaded = LoadRecognizer(args.recognizer, options, "recognize");
+  const LoadedRecognizer loaded = LoadRecognizer(args.recognizer, options.track, "recognize");
   Recognizer& recognizer = *loaded.recognizer;
   return single ? RecognizeOneFrame(args, *single, *loaded.library, recognizer)
-                : RecognizeSequence(args, *feed, *loaded.library, recognizer);
+                : RecognizeSequence(args, *feed, *loaded.library, recognizer, options.search);
 }
 
 }  // namespace

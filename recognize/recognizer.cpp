@@ -209,20 +209,22 @@ class Recognizer::Impl {
         ransac_threads);
   }
 
-  // Each model's priors tried at their poses (Track), the models on the workers; a prior that fails makes its model
-  // lost.
+  // Each model's priors tried at their poses (Track), the models on the workers, the best of them kept
+  // (KeepBestFollowed); a prior that fails makes its model lost.
   void FollowPriors(const Scene& scene, std::vector<ModelInFrame>* models) {
     ParallelFor(models->size(), options_.ransac.threads, [&](size_t m) {
       ModelInFrame& model = (*models)[m];
+      std::vector<Followed> followed;
       for (const Detection* prior : model.priors) {
-        if (static_cast<int>(model.instances.size()) >= options_.max_instances) break;
         Verified tracked = Track(m, *prior, scene);
         if (Accepted(tracked.detection)) {
-          AddInstance(std::move(tracked), options_.dense_stride_px, scene.frame->depth.size(), &model);
+          followed.push_back({std::move(tracked), !prior->tracked});
         } else {
           model.lost = true;
         }
       }
+      KeepBestFollowed(std::move(followed), scene.frame->depth.size(), options_.max_overlap, options_.max_instances,
+                       options_.dense_stride_px, &model);
     });
   }
 
@@ -320,22 +322,27 @@ class Recognizer::Impl {
     return pose;
   }
 
-  // A prior's model at the prior's pose, refined by ICP when that raises the score (its RANSAC fields stay 0).
+  // A prior's model at the prior's pose refined by ICP (from the model's surface rendered there) and verified. The
+  // prior's own pose is verified only when the refined one is not accepted, and the better kept (RANSAC fields 0).
   Verified Track(size_t model, const Detection& prior, const Scene& scene) {
     Hypothesis hypothesis;
     hypothesis.view = prior.view;
     hypothesis.pose = prior.camera_from_object;
-    Verified best = Verify(model, scene, hypothesis);
+    std::optional<Verified> best;
     if (options_.refine) {
-      Search(model, scene, 1).Refine(best.depth, &hypothesis);
-      Verified refined = Verify(model, scene, hypothesis);
-      if (refined.detection.score >= best.detection.score) best = std::move(refined);
+      Hypothesis refined = hypothesis;
+      Search(model, scene, 1).Refine(Render(model, scene, hypothesis.pose).depth, &refined);
+      best = Verify(model, scene, refined);
     }
-    best.detection.tracked = true;
-    best.detection.frames_followed = prior.frames_followed + 1;
-    best.detection.confirmed = prior.confirmed;
-    best.detection.hypothesis = prior.hypothesis;
-    return best;
+    if (!best || !Accepted(best->detection)) {
+      Verified at_prior = Verify(model, scene, hypothesis);
+      if (!best || at_prior.detection.score > best->detection.score) best = std::move(at_prior);
+    }
+    best->detection.tracked = true;
+    best->detection.frames_followed = prior.frames_followed + 1;
+    best->detection.confirmed = prior.confirmed;
+    best->detection.hypothesis = prior.hypothesis;
+    return std::move(*best);
   }
 
   // A model's point pair table: of its stored points when they were drawn as the options draw them, else of points
@@ -430,15 +437,17 @@ class Recognizer::Impl {
     return kept;
   }
 
-  // The model rendered at the pose (one render at a time: one GL context), measured against the frame and scored.
+  // The model rendered at `pose` at the frame's dense stride (one render at a time: one GL context).
+  RenderResult Render(size_t model, const Scene& scene, const Eigen::Isometry3d& pose) {
+    const PinholeCamera camera = scene.frame->camera.Sampled(options_.dense_stride_px);
+    const std::lock_guard<std::mutex> lock(render_mutex_);
+    return renderer_.Render(meshes_[model], camera, pose, render_options_[model]);
+  }
+
+  // The model rendered at the pose, measured against the frame and scored.
   Verified Verify(size_t model, const Scene& scene, const Hypothesis& hypothesis) {
     const LibraryModel& library_model = library_.models()[model];
-    const PinholeCamera camera = scene.frame->camera.Sampled(options_.dense_stride_px);
-    RenderResult rendered;
-    {
-      const std::lock_guard<std::mutex> lock(render_mutex_);
-      rendered = renderer_.Render(meshes_[model], camera, hypothesis.pose, render_options_[model]);
-    }
+    const RenderResult rendered = Render(model, scene, hypothesis.pose);
     Eigen::Matrix3f to_scene = Eigen::Matrix3f::Identity();
     if (options_.verify.use_color_matrix && library_model.color_matrix) {
       to_scene = library_model.color_matrix->model_to_scene.cast<float>();

@@ -57,6 +57,9 @@ struct RecognitionResult {
   int scene_primitives = 0;
   /// Per model searched in the frame (not only tracked): the library views RANSAC ran on.
   std::map<std::string, int> views_tried;
+  /// With a search beside the tracking (StreamOptions::search_beside): how many frames before this one the frame lay
+  /// whose search's detections joined this frame's priors; -1: none did.
+  int searched_frames_ago = -1;
 };
 
 /// One library view as view ranking saw it in a frame.
@@ -70,7 +73,7 @@ struct RankedView {
 
 /// The detections JSON that `ecvpose recognize --out-json` writes: {"detections": [{"model", "score",
 /// "camera_from_object", "inlier_fraction", "fit_error", "view", ..., "tracked", "confirmed", "hypothesis"}],
-/// "timings_ms": {stage: ms}}.
+/// "timings_ms": {stage: ms}, ...}, with "searched_frames_ago" when a search beside the tracking joined the frame.
 nlohmann::json RecognitionToJson(const RecognitionResult& result);
 
 /// The detections of such JSON (model, score, camera_from_object, hypothesis); throws InputError naming `source`
@@ -94,6 +97,9 @@ enum class SearchScope {
   /// extracted. RecognitionStream alternates it with full frames to follow known objects at a fraction of the cost
   /// and still pick up new ones every N frames.
   kLostTracks,
+  /// No model is searched, not even for confirmation: the priors are followed, nothing else (RecognitionStream's
+  /// tracking when the search runs beside it, StreamOptions::search_beside).
+  kPriorsOnly,
 };
 
 /// Finds the library's models in RGB-D frames. Owns an offscreen renderer (for verification) with the
@@ -110,7 +116,9 @@ class Recognizer {
   /// Tracking, for frames of a stream (beyond the paper): each prior (a detection of the previous frame) that scored
   /// at least tracking.min_follow_score is first tried at its pose, refined by ICP and verified as any detection;
   /// when it passes, its model skips view ranking and RANSAC in this frame, unless the track is due for confirmation
-  /// (tracking.confirm_every). Which of the other models are searched: see SearchScope.
+  /// (tracking.confirm_every). A model's priors are all tried and compete on score (KeepBestFollowed): a search's
+  /// detection given beside a track of the same object confirms it. Which of the other models are searched: see
+  /// SearchScope.
   RecognitionResult Recognize(const RgbdFrame& frame, const std::vector<Detection>& priors,
                               SearchScope scope = SearchScope::kAllModels);
 

@@ -165,6 +165,12 @@ void AddTrackingSettings(std::vector<Setting>* table) {
       "after a broken frame, the next); in between, the tracked objects are followed and a lost one is\n"
       "searched for at once",
       [](auto& s) -> auto& { return s.stream.search_every; }));
+  table->push_back(Flag(
+      "search-beside", false,
+      "With --track: the search runs on a thread of its own beside the tracking (--threads shared: on 2,\n"
+      "one tracks, one searches); each frame only follows the objects it knows, and a finished search's\n"
+      "detections join the next frame's (new objects are found a few frames late)",
+      [](auto& s) -> auto& { return s.stream.search_beside; }));
   Setting score = Number(
       "track-score", 0, 1,
       "With --track: a detection is followed into the next frame only while it scores at least this,\n"

@@ -20,7 +20,7 @@ namespace ecv {
 /// What the settings table reads and writes: the recognizer's options and the stream's.
 struct RecognizerSettings {
   RecognizerOptions options;
-  StreamOptions stream;  ///< track, search_every
+  StreamOptions stream;  ///< track, search_every, search_beside
 };
 
 enum class SettingType {

@@ -290,10 +290,12 @@ ReadRoots ServeRoots(const ServeArgs& args) {
 int RunServe(const ServeArgs& args) {
   const mode_t socket_mode = ParseSocketMode(args.socket_mode);
   const ReadRoots roots = ServeRoots(args);
-  const RecognizerOptions options = RecognizerOptionsFromArgs(args.recognizer);
-  const LoadedRecognizer loaded = LoadRecognizer(args.recognizer, options, "serve");
+  const StreamRecognizerOptions options =
+      ShareThreads(RecognizerOptionsFromArgs(args.recognizer), args.recognizer.stream);
+  const LoadedRecognizer loaded = LoadRecognizer(args.recognizer, options.track, "serve");
   const auto make_service = [&] {
-    return RecognitionService(*loaded.recognizer, args.recognizer.stream, args.limits, roots);
+    return RecognitionService(*loaded.recognizer, args.recognizer.stream, args.limits, roots,
+                              MakeRecognizerFactory(*loaded.library, options.search));
   };
   InstallStopHandlers();
   if (!args.socket.empty()) {

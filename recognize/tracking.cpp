@@ -33,7 +33,8 @@ int ChooseModels(SearchScope scope, const TrackingOptions& tracking, int max_ins
   int count = 0;
   for (ModelInFrame& model : *models) {
     const bool due =
-        confirm_every > 0 && std::any_of(model.instances.begin(), model.instances.end(), [&](const Verified& instance) {
+        scope != SearchScope::kPriorsOnly && confirm_every > 0 &&
+        std::any_of(model.instances.begin(), model.instances.end(), [&](const Verified& instance) {
           return instance.detection.frames_followed >= (instance.detection.confirmed ? confirm_every : confirm_first);
         });
     if (due) {
@@ -42,38 +43,50 @@ int ChooseModels(SearchScope scope, const TrackingOptions& tracking, int max_ins
       model.covered = cv::Mat();
     }
     model.search = due || (static_cast<int>(model.instances.size()) < max_instances &&
-                           (scope == SearchScope::kAllModels || model.lost));
+                           (scope == SearchScope::kAllModels || (scope == SearchScope::kLostTracks && model.lost)));
     count += model.search ? 1 : 0;
   }
   return count;
 }
 
-void MergeConfirmation(const cv::Size& image_size, double max_overlap, int max_instances, int stride,
-                       ModelInFrame* model) {
-  if (model->to_confirm.empty()) return;
-  std::vector<Verified> candidates = std::move(model->to_confirm);
-  model->to_confirm.clear();
-  for (Verified& searched : model->instances) candidates.push_back(std::move(searched));
-  std::stable_sort(candidates.begin(), candidates.end(),
-                   [](const Verified& a, const Verified& b) { return a.detection.score > b.detection.score; });
-  model->instances.clear();
-  model->covered = cv::Mat();
-  for (Verified& candidate : candidates) {
-    Verified* same_surface = nullptr;
-    for (Verified& kept : model->instances) {
-      if (SharedFraction(candidate.surface, kept.surface, image_size) > max_overlap) same_surface = &kept;
+void KeepBestFollowed(std::vector<Followed> followed, const cv::Size& image_size, double max_overlap, int max_instances,
+                      int stride, ModelInFrame* model) {
+  std::stable_sort(followed.begin(), followed.end(), [](const Followed& a, const Followed& b) {
+    return a.verified.detection.score > b.verified.detection.score;
+  });
+  std::vector<bool> kept_from_search;  // per instance
+  for (Followed& candidate : followed) {
+    size_t same_surface = model->instances.size();
+    for (size_t k = 0; k < model->instances.size(); ++k) {
+      if (SharedFraction(candidate.verified.surface, model->instances[k].surface, image_size) > max_overlap) {
+        same_surface = k;
+      }
     }
-    if (same_surface != nullptr) {
-      if (same_surface->detection.tracked != candidate.detection.tracked) {
-        same_surface->detection.frames_followed = 0;
-        same_surface->detection.confirmed = true;
+    if (same_surface < model->instances.size()) {
+      Detection& kept = model->instances[same_surface].detection;
+      if (kept_from_search[same_surface] != candidate.from_search) {
+        kept.frames_followed = std::min(kept.frames_followed, candidate.verified.detection.frames_followed);
+        kept.confirmed = true;
       }
       continue;
     }
     if (static_cast<int>(model->instances.size()) < max_instances) {
-      AddInstance(std::move(candidate), stride, image_size, model);
+      kept_from_search.push_back(candidate.from_search);
+      AddInstance(std::move(candidate.verified), stride, image_size, model);
     }
   }
+}
+
+void MergeConfirmation(const cv::Size& image_size, double max_overlap, int max_instances, int stride,
+                       ModelInFrame* model) {
+  if (model->to_confirm.empty()) return;
+  std::vector<Followed> candidates;  // the tracks, then the search's instances (from_search)
+  for (Verified& track : model->to_confirm) candidates.push_back({std::move(track), false});
+  for (Verified& searched : model->instances) candidates.push_back({std::move(searched), true});
+  model->to_confirm.clear();
+  model->instances.clear();
+  model->covered = cv::Mat();
+  KeepBestFollowed(std::move(candidates), image_size, max_overlap, max_instances, stride, model);
 }
 
 double SharedFraction(const std::vector<cv::Point>& surface, const std::vector<cv::Point>& other,

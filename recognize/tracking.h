@@ -35,10 +35,24 @@ void AddInstance(Verified verified, int stride, const cv::Size& image_size, Mode
 std::vector<ModelInFrame> AssignPriors(const std::vector<Detection>& priors,
                                        const std::vector<std::string>& model_names, const TrackingOptions& tracking);
 
+/// An instance followed from a prior (Recognizer's Track), and whether that prior was a search's detection rather than
+/// a track: one followed from the previous frame's search, or from a search that ran beside the tracking.
+struct Followed {
+  Verified verified;
+  bool from_search = false;
+};
+
+/// Makes `model`'s instances (it has none yet) the best of those followed from its priors: best first, each kept
+/// unless it lies mostly (`max_overlap`) on a kept one's surface, up to `max_instances`, so that a search's detection
+/// given as a prior beside a track competes with it on score. A kept one on whose surface one of the other kind lay (a
+/// track and a search's detection) is confirmed (Detection::confirmed), its frames_followed the smaller of theirs.
+void KeepBestFollowed(std::vector<Followed> followed, const cv::Size& image_size, double max_overlap, int max_instances,
+                      int stride, ModelInFrame* model);
+
 /// Marks the models to search in this frame: those with fewer than `max_instances` instances (under kLostTracks only
-/// lost ones), and those with a track due for confirmation (followed tracking.confirm_every frames, or
-/// tracking.confirm_first while no search has confirmed it), whose tracked instances are set aside meanwhile. Returns
-/// their count.
+/// lost ones, under kPriorsOnly none), and those with a track due for confirmation (followed tracking.confirm_every
+/// frames, or tracking.confirm_first while no search has confirmed it; never under kPriorsOnly), whose tracked
+/// instances are set aside meanwhile. Returns their count.
 int ChooseModels(SearchScope scope, const TrackingOptions& tracking, int max_instances,
                  std::vector<ModelInFrame>* models);
 

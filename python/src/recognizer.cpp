@@ -25,11 +25,14 @@ namespace {
 // A Recognizer with its library and its stream of frames: one call at a time (the renderer is not shared).
 class StreamRecognizer {
  public:
+  // With search_beside, the recognizer tracks on its share of the threads, and the stream's searcher, on its own
+  // thread, takes the rest (ShareThreads).
   StreamRecognizer(std::shared_ptr<Library> library, const RecognizerSettings& settings)
       : library_(std::move(library)),
         settings_(settings),
-        recognizer_(library_->library(), settings.options),
-        stream_(recognizer_, settings.stream) {}
+        recognizer_(library_->library(), ShareThreads(settings.options, settings.stream).track),
+        stream_(recognizer_, settings.stream,
+                MakeRecognizerFactory(library_->library(), ShareThreads(settings.options, settings.stream).search)) {}
 
   RecognitionResult Recognize(const RgbdFrame& frame) {
     const std::lock_guard<std::mutex> lock(mutex_);

@@ -253,22 +253,26 @@ TEST_F(ServeProtocol, TheServiceGoesOnAfterHostileLines) {
   EXPECT_NE(answers[3].at("error").get<std::string>().find("/no/such/000001"), std::string::npos);
 }
 
+// A followed object is tracked, or, when its track was due for confirmation (the frame after the search that found
+// it), confirmed by the search's pose on its surface if that scored higher.
 TEST_F(ServeProtocol, TrackedRequestsFollowTheirObjectsUntilAResetOrAnUntrackedOne) {
   RecognitionService service(*recognizer_, StreamOptions{});
   const std::string frame = "\"frame\": \"" + DemoFrame() + "\"";
-  const auto tracked_count = [&](const std::string& request) {
+  const auto followed_count = [&](const std::string& request) {
     const nlohmann::json response = service.Handle("{" + frame + request + "}");
-    int tracked = 0;
-    for (const nlohmann::json& detection : response.at("detections")) tracked += detection.at("tracked") ? 1 : 0;
+    int followed = 0;
+    for (const nlohmann::json& detection : response.at("detections")) {
+      followed += detection.at("tracked") || detection.at("confirmed") ? 1 : 0;
+    }
     EXPECT_EQ(response.at("detections").size(), 3U) << request;
-    return tracked;
+    return followed;
   };
-  EXPECT_EQ(tracked_count(", \"track\": true"), 0);  // the first frame of a stream searches
-  EXPECT_EQ(tracked_count(", \"track\": true"), 3);
-  EXPECT_EQ(tracked_count(", \"track\": true, \"reset\": true"), 0);
-  EXPECT_EQ(tracked_count(", \"track\": true"), 3);
-  EXPECT_EQ(tracked_count(""), 0);  // a frame on its own (the service's default) ends the tracks
-  EXPECT_EQ(tracked_count(", \"track\": true"), 0);
+  EXPECT_EQ(followed_count(", \"track\": true"), 0);  // the first frame of a stream searches
+  EXPECT_EQ(followed_count(", \"track\": true"), 3);
+  EXPECT_EQ(followed_count(", \"track\": true, \"reset\": true"), 0);
+  EXPECT_EQ(followed_count(", \"track\": true"), 3);
+  EXPECT_EQ(followed_count(""), 0);  // a frame on its own (the service's default) ends the tracks
+  EXPECT_EQ(followed_count(", \"track\": true"), 0);
 }
 
 // With roots, a request reads only regular files below them: a path outside, a link leading out (of a YCB-Video prefix

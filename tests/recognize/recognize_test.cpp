@@ -412,6 +412,50 @@ TEST_F(RecognizeEndToEnd, ATrackTheConfirmingSearchDisagreesWithIsReplaced) {
   EXPECT_LT(TranslationDistance(first.detections[0].camera_from_object, truth->camera_from_object), 0.01);
 }
 
+// What the search beside the tracking relies on (StreamOptions::search_beside): under SearchScope::kPriorsOnly nothing
+// is searched, and a search's detection given as a prior beside a track of its model competes with it on score, not
+// dropped because the model has its max_instances (1) of priors already. Beside a wrong track (20 cm off), the
+// search's right pose is kept; beside a right one, the better of the two is kept, confirmed, its frames_followed the
+// smaller.
+TEST_F(RecognizeEndToEnd, ASearchsDetectionGivenBesideATrackCompetesWithItAndConfirmsIt) {
+  const ModelLibrary library = Library({"003_cracker_box"});
+  const LoadedFrame frame = LoadYcbvFrame(Frame());
+  RecognizerOptions options;
+  options.verify.min_score = 0.0;
+  options.verify.min_visible_fraction = 0.0;
+  options.refine = false;  // the wrong prior stays where it is put
+  ASSERT_EQ(options.max_instances, 1);
+  Recognizer recognizer(library, options);
+  const GroundTruth* truth = TruthOf(frame, "003_cracker_box");
+  ASSERT_NE(truth, nullptr);
+  const std::vector<Detection> searched = recognizer.Recognize(frame.rgbd).detections;
+  ASSERT_EQ(searched.size(), 1U);
+  ASSERT_FALSE(searched[0].tracked);
+  Detection track = searched[0];
+  track.tracked = true;
+  track.frames_followed = 6;
+  track.camera_from_object.translation().x() += 0.2;
+  Detection search = searched[0];
+  search.frames_followed = 2;  // searched 3 frames ago
+
+  const RecognitionResult wrong = recognizer.Recognize(frame.rgbd, {track, search}, SearchScope::kPriorsOnly);
+  ASSERT_EQ(wrong.detections.size(), 1U);
+  EXPECT_TRUE(wrong.detections[0].tracked);
+  EXPECT_FALSE(wrong.detections[0].confirmed);  // on another surface than the track's
+  EXPECT_EQ(wrong.detections[0].frames_followed, 3);
+  EXPECT_LT(TranslationDistance(wrong.detections[0].camera_from_object, truth->camera_from_object), 0.01);
+  EXPECT_TRUE(wrong.views_tried.empty());
+  EXPECT_EQ(wrong.timings_ms.count("extract"), 0U);
+
+  track.camera_from_object = searched[0].camera_from_object;
+  const RecognitionResult right = recognizer.Recognize(frame.rgbd, {track, search}, SearchScope::kPriorsOnly);
+  ASSERT_EQ(right.detections.size(), 1U);
+  EXPECT_TRUE(right.detections[0].confirmed);
+  EXPECT_EQ(right.detections[0].frames_followed, 3);
+  EXPECT_LT(TranslationDistance(right.detections[0].camera_from_object, truth->camera_from_object), 0.01);
+  EXPECT_TRUE(right.views_tried.empty());
+}
+
 // A tracking frame that searches only for lost tracks (SearchScope::kLostTracks, `recognize --search-every`):
 // the cracker box follows its prior; the mustard bottle's prior lies 30 cm off, fails, and the bottle is
 // searched for at once; the sugar box has no prior and is not looked for until a full frame.
@@ -536,6 +580,11 @@ TEST_F(RecognizeEndToEnd, BadInputIsReported) {
   EXPECT_EQ(untracked.exit_code, 1) << untracked.output;
   EXPECT_NE(untracked.output.find("--search-every"), std::string::npos) << untracked.output;
   EXPECT_NE(untracked.output.find("--track"), std::string::npos) << untracked.output;
+  const test::CommandResult beside_untracked = test::RunCli(
+      "recognize --db " + library_ + " --sequence " + std::string(ECV_SOURCE_DIR) + "/models/frame --search-beside");
+  EXPECT_EQ(beside_untracked.exit_code, 1) << beside_untracked.output;
+  EXPECT_NE(beside_untracked.output.find("--search-beside: expected --track as well"), std::string::npos)
+      << beside_untracked.output;
   const test::CommandResult unknown_source =
       test::RunCli("recognize --db " + library_ + " --hypotheses shape " + Frame());
   EXPECT_EQ(unknown_source.exit_code, 2) << unknown_source.output;

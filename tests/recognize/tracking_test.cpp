@@ -84,6 +84,55 @@ TEST(Tracking, ModelsSearchedAreThoseNotFoundUnderTheScopeAndThoseDueForConfirma
   EXPECT_EQ(ChooseModels(SearchScope::kLostTracks, tracking, 1, &never), 0);
 }
 
+TEST(Tracking, FollowingThePriorsOnlySearchesNoModelNeitherLostNorDue) {
+  TrackingOptions tracking;
+  std::vector<ModelInFrame> models(3);
+  models[0].lost = true;
+  AddInstance(Instance(0.6, {8, 8, 4, 4}, true, 50), 1, kImage, &models[1]);  // long due for confirmation
+  EXPECT_EQ(ChooseModels(SearchScope::kPriorsOnly, tracking, 1, &models), 0);
+  for (const ModelInFrame& model : models) EXPECT_FALSE(model.search);
+  EXPECT_EQ(models[1].instances.size(), 1U);  // not set aside
+  EXPECT_TRUE(models[1].to_confirm.empty());
+}
+
+// The priors of one model, followed: a search's detection beside the tracks (RecognitionStream's search beside the
+// tracking) competes with them on score.
+TEST(Tracking, FollowedPriorsCompeteOnScoreAndASearchsDetectionConfirmsATrackOnItsSurface) {
+  // One instance allowed: the better of a track and a search's detection elsewhere, whichever prior came first.
+  ModelInFrame one;
+  std::vector<Followed> elsewhere;
+  elsewhere.push_back({Instance(0.5, {0, 0, 10, 10}, true, 7), false});
+  elsewhere.push_back({Instance(0.8, {30, 30, 10, 10}, true, 2), true});
+  KeepBestFollowed(std::move(elsewhere), kImage, 0.3, 1, 1, &one);
+  ASSERT_EQ(one.instances.size(), 1U);
+  EXPECT_DOUBLE_EQ(one.instances[0].detection.score, 0.8);
+  EXPECT_FALSE(one.instances[0].detection.confirmed);  // no track on its surface
+  EXPECT_EQ(cv::countNonZero(one.covered), 12 * 12);   // its surface and a pixel round it
+
+  // On one surface: the better kept, confirmed, counting from the search; two instances allowed, one is kept.
+  for (const bool search_better : {false, true}) {
+    ModelInFrame same;
+    std::vector<Followed> followed;
+    followed.push_back({Instance(search_better ? 0.6 : 0.7, {0, 0, 10, 10}, true, 7), false});
+    followed.push_back({Instance(search_better ? 0.7 : 0.6, {1, 1, 10, 10}, true, 2), true});
+    KeepBestFollowed(std::move(followed), kImage, 0.3, 2, 1, &same);
+    ASSERT_EQ(same.instances.size(), 1U) << search_better;
+    EXPECT_DOUBLE_EQ(same.instances[0].detection.score, 0.7) << search_better;
+    EXPECT_TRUE(same.instances[0].detection.confirmed) << search_better;
+    EXPECT_EQ(same.instances[0].detection.frames_followed, 2) << search_better;
+  }
+
+  // Two tracks on one surface (no search among them): one kept, not confirmed.
+  ModelInFrame tracks;
+  std::vector<Followed> two;
+  two.push_back({Instance(0.6, {0, 0, 10, 10}, true, 7), false});
+  two.push_back({Instance(0.7, {1, 1, 10, 10}, true, 3), false});
+  KeepBestFollowed(std::move(two), kImage, 0.3, 2, 1, &tracks);
+  ASSERT_EQ(tracks.instances.size(), 1U);
+  EXPECT_FALSE(tracks.instances[0].detection.confirmed);
+  EXPECT_EQ(tracks.instances[0].detection.frames_followed, 3);
+}
+
 TEST(Tracking, AConfirmingSearchKeepsTheBetterPoseOfASurfaceAndConfirmsATrackItFound) {
   // The search finds the tracked surface with a lower score: the track stays, confirmed (its count starts again).
   ModelInFrame confirmed;

@@ -4,14 +4,18 @@
 // 0002 (7 textured objects in all), scored against the ground truth.
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <stdexcept>
+#include <thread>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
+#include "core/pose.h"
 #include "io/frame_io.h"
 #include "io/mesh_io.h"
 #include "io/points_io.h"
@@ -707,6 +711,62 @@ TEST_F(YcbvLibrary, TheCliTracksAsTheRecognitionStreamDoes) {
     EXPECT_EQ(lines[i].at("timings_ms").contains("extract"), i <= 2) << frames[i];
   }
   EXPECT_GE(tracked, 6);  // frames 2-4 follow the three objects
+}
+
+// --search-beside on two threads: each frame only follows the objects it knows while a second recognizer searches on
+// a thread of its own. Fed one frame at 30 per second (0001/000001), the stream returns nothing until the first search
+// is done, then the frame after it holds that search's three objects, followed into it (tracked) at their poses, and
+// the next frames keep them.
+TEST_F(YcbvLibrary, TheSearchBesideTheTrackingBringsItsObjectsIntoTheFramesAfterIt) {
+  LibraryLoadOptions load;
+  load.build_matchers = false;
+  const ModelLibrary library = ModelLibrary::Load(library_, load);
+  const LoadedFrame frame = LoadYcbvFrame(test::DataPath("ycbv_subset/Example-Scenes/0001/000001"));
+  StreamOptions beside;
+  beside.track = true;
+  beside.search_beside = true;
+  RecognizerOptions options;
+  options.ransac.threads = 2;
+  const StreamRecognizerOptions shared = ShareThreads(options, beside);
+  EXPECT_EQ(shared.track.ransac.threads, 1);  // one thread tracks, one searches
+  EXPECT_EQ(shared.search.ransac.threads, 1);
+  Recognizer tracker(library, shared.track);
+  RecognitionStream stream(tracker, beside, MakeRecognizerFactory(library, shared.search));
+
+  // The searcher is made on its thread, then searches (seconds under the sanitizers): a bound, not a measure.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::minutes(3);
+  std::optional<RecognitionResult> joined;
+  int before = 0;
+  while (!joined && std::chrono::steady_clock::now() < deadline) {
+    RecognitionResult result = stream.Next(frame.rgbd);
+    if (result.searched_frames_ago >= 0) {
+      joined = std::move(result);
+    } else {
+      EXPECT_TRUE(result.detections.empty()) << "frame " << before;  // no search done: nothing to follow
+      EXPECT_EQ(result.timings_ms.count("extract"), 0U) << "frame " << before;
+      ++before;
+      std::this_thread::sleep_for(std::chrono::milliseconds(33));
+    }
+  }
+  ASSERT_TRUE(joined) << "no search done in 3 minutes";
+  EXPECT_GE(before, 1);
+  EXPECT_GE(joined->searched_frames_ago, 1);
+  EXPECT_EQ(RecognitionToJson(*joined).at("searched_frames_ago"), joined->searched_frames_ago);
+  std::vector<RecognitionResult> results = {*joined};
+  for (int i = 0; i < 2; ++i) results.push_back(stream.Next(frame.rgbd));
+  for (size_t i = 0; i < results.size(); ++i) {
+    ASSERT_EQ(results[i].detections.size(), 3U) << "frame " << before + i;  // cracker box, sugar box, mustard bottle
+    EXPECT_EQ(results[i].timings_ms.count("extract"), 0U) << "frame " << before + i;
+    for (const Detection& detection : results[i].detections) {
+      const auto truth = std::find_if(frame.ground_truth.begin(), frame.ground_truth.end(),
+                                      [&](const GroundTruth& t) { return t.object_name == detection.model; });
+      ASSERT_NE(truth, frame.ground_truth.end()) << detection.model;
+      EXPECT_TRUE(detection.tracked) << detection.model;
+      EXPECT_LT(TranslationDistance(detection.camera_from_object, truth->camera_from_object), 0.01) << detection.model;
+      EXPECT_LT(RotationAngle(detection.camera_from_object, truth->camera_from_object), 10.0 * M_PI / 180.0)
+          << detection.model;
+    }
+  }
 }
 
 TEST_F(YcbvLibrary, BrokenFrameInSequenceIsReportedAndTheOthersAreProcessed) {
