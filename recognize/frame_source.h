@@ -27,6 +27,9 @@ class FrameSource {
 
   /// Progress before a frame's report: "[3/10] " when the number of frames is known, "[3] " otherwise.
   virtual std::string Counter() const = 0;
+
+  /// Frames passed over just before the one Next moved to (a live feed that keeps only the newest; 0 for others).
+  virtual int Skipped() const { return 0; }
 };
 
 /// Opens the sources a front end knows beyond files (a camera, a recording): a source for `sequence`, or nullptr when

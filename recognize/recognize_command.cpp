@@ -34,6 +34,7 @@ struct RecognizeArgs {
   FrameSpec frame;
   std::string sequence;
   bool follow = false;
+  bool latest = false;
   double idle_timeout_s = 10.0;
   std::string out_json;
   std::string out_bop;
@@ -170,9 +171,11 @@ int RecognizeSequence(const RecognizeArgs& args, FrameSource& feed, const ModelL
       const RecognitionResult result = stream.Next(loaded.rgbd);
       total_ms += result.timings_ms.at("total");
       report << feed.Counter();
+      if (feed.Skipped() > 0) report << "(" << feed.Skipped() << " older frames skipped) ";
       PrintDetections(report, loaded, result);
       nlohmann::json line = RecognitionToJson(result);
       line["frame"] = *frame;
+      if (feed.Skipped() > 0) line["skipped_before"] = feed.Skipped();
       // The picture is written before the frame's line, so that a reader of the lines (ecvpose-view) finds it whole.
       if (!args.overlay.empty()) {
         const std::string picture = OverlayPath(args.overlay, done + failed + 1);
@@ -213,7 +216,7 @@ std::unique_ptr<FrameSource> OpenSequence(const RecognizeArgs& args, const Frame
                     "with --sequence, an openni2:// camera or a .oni recording (frame files "
                     "carry their own intrinsics)");
   }
-  return std::make_unique<FrameFeed>(args.sequence, args.follow, args.idle_timeout_s);
+  return std::make_unique<FrameFeed>(args.sequence, args.follow, args.idle_timeout_s, args.latest);
 }
 
 int RunRecognize(const RecognizeArgs& args, const FrameSourceOpener& open_live) {
@@ -223,6 +226,10 @@ int RunRecognize(const RecognizeArgs& args, const FrameSourceOpener& open_live) 
   }
   if (args.follow && args.sequence.empty()) {
     std::cerr << "ecvpose recognize: --follow needs --sequence FOLDER\n";
+    return kExitBadUsage;
+  }
+  if (args.latest && !args.follow) {
+    std::cerr << "ecvpose recognize: --latest needs --follow\n";
     return kExitBadUsage;
   }
   const StreamRecognizerOptions options = ShareThreads(OptionsFromArgs(args), args.recognizer.stream);
@@ -253,6 +260,10 @@ CommandAction SetupRecognizeCommand(CLI::App& command, FrameSourceOpener open_li
   command.add_flag("--follow", args->follow,
                    "With --sequence FOLDER: also take the frame JSONs that appear in the folder while it runs (write\n"
                    "the images first, the JSON last, by rename), until --idle-timeout passes without a new one");
+  command.add_flag("--latest", args->latest,
+                   "With --follow: when several frames are waiting, recognise the newest and skip the others (its\n"
+                   "line says \"skipped_before\": N), so that a live feed keeps its latency when a frame takes\n"
+                   "longer than the camera's interval");
   command.add_option("--idle-timeout", args->idle_timeout_s, "With --follow: seconds to wait for a new frame")
       ->capture_default_str()
       ->check(NonNegative());

@@ -40,8 +40,8 @@ void LineOutput::Write(const std::string& text) {
   }
 }
 
-FrameFeed::FrameFeed(const std::string& sequence, bool follow, double idle_timeout_s)
-    : folder_(sequence), follow_(follow), idle_timeout_(idle_timeout_s) {
+FrameFeed::FrameFeed(const std::string& sequence, bool follow, double idle_timeout_s, bool latest)
+    : folder_(sequence), follow_(follow), latest_(latest && follow), idle_timeout_(idle_timeout_s) {
   if (!follow) {
     frames_ = ListSequenceFrames(sequence);
     return;
@@ -87,6 +87,7 @@ void FrameFeed::Scan() {
 }
 
 std::optional<std::string> FrameFeed::Next() {
+  if (latest_) Scan();  // what arrived while the last frame was recognised
   if (follow_ && next_ == frames_.size()) {
     const auto since = std::chrono::steady_clock::now();
     while (next_ == frames_.size()) {
@@ -97,6 +98,8 @@ std::optional<std::string> FrameFeed::Next() {
     }
   }
   if (next_ == frames_.size()) return std::nullopt;
+  skipped_ = latest_ ? static_cast<int>(frames_.size() - 1 - next_) : 0;
+  next_ += static_cast<size_t>(skipped_);
   return frames_[next_++];
 }
 

@@ -37,10 +37,10 @@ class LineOutput {
 
 /// The frame files of --sequence, in order. With `follow`, the frame JSONs of a folder still being filled, in name
 /// order as they appear (a producer writes the images first and the JSON last, by rename), until `idle_timeout_s` pass
-/// without a new one.
+/// without a new one; with `latest` too, only the newest of the frames waiting, the others skipped.
 class FrameFeed : public FrameSource {
  public:
-  FrameFeed(const std::string& sequence, bool follow, double idle_timeout_s);
+  FrameFeed(const std::string& sequence, bool follow, double idle_timeout_s, bool latest = false);
   ~FrameFeed() override;
   FrameFeed(const FrameFeed&) = delete;
   FrameFeed& operator=(const FrameFeed&) = delete;
@@ -54,12 +54,16 @@ class FrameFeed : public FrameSource {
   /// "[3/10] " for a list of known length, "[3] " when following.
   std::string Counter() const override;
 
+  int Skipped() const override { return skipped_; }
+
  private:
   void Scan();                                    // adds the folder's frame JSONs not seen yet, in name order
   void Wait(std::chrono::duration<double> most);  // until a file lands in the folder (inotify), or `most` passes
 
   std::string folder_;
   bool follow_;
+  bool latest_;
+  int skipped_ = 0;
   std::chrono::duration<double> idle_timeout_;
   std::vector<std::string> frames_;
   size_t next_ = 0;

@@ -3,10 +3,12 @@
 // second mustard bottle pasted in from another real frame).
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <thread>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -562,6 +564,50 @@ TEST_F(RecognizeEndToEnd, FindsBothOfTwoMustardBottlesWhenAskedForTwoInstances) 
     }
   }
   EXPECT_GE(near, 5) << "of 6 bottles";
+}
+
+// --follow answers the frame JSONs written into its folder while it runs; with --latest, of the frames waiting only
+// the newest, its line saying how many it skipped.
+TEST_F(RecognizeEndToEnd, FollowsAFolderAndWithLatestTakesTheNewestWaitingFrame) {
+  namespace fs = std::filesystem;
+  const LoadedFrame scene = LoadYcbvFrame(Frame());
+  const fs::path waiting = directory_->path() / "waiting", later = directory_->path() / "later";
+  fs::create_directories(waiting);
+  fs::create_directories(later);
+  for (const char* name : {"a", "b", "c"}) WriteFrameJson((waiting / name).string() + ".json", scene.rgbd);
+  const auto lines_of = [](const std::string& path) {
+    std::vector<nlohmann::json> lines;
+    std::ifstream in(path);
+    for (std::string line; std::getline(in, line);) lines.push_back(nlohmann::json::parse(line));
+    return lines;
+  };
+  const std::string newest = directory_->File("newest.jsonl");
+  const test::CommandResult latest = test::RunCli("recognize --db " + library_ + " --sequence " + waiting.string() +
+                                                  " --follow --latest --idle-timeout 0.5 --out-json " + newest);
+  ASSERT_EQ(latest.exit_code, 0) << latest.output;
+  const std::vector<nlohmann::json> answered = lines_of(newest);
+  ASSERT_EQ(answered.size(), 1U);
+  EXPECT_EQ(fs::path(answered[0].at("frame").get<std::string>()).filename(), "c.json");
+  EXPECT_EQ(answered[0].at("skipped_before"), 2);
+  EXPECT_EQ(answered[0].at("detections").size(), 3U);
+
+  // A frame written into the folder (images first, the JSON last by rename) after the recognizer started.
+  const std::string followed = directory_->File("followed.jsonl");
+  std::thread producer([&] {
+    std::this_thread::sleep_for(std::chrono::seconds(3));
+    WriteFrameJson((later / "d").string() + ".tmp", scene.rgbd);
+    fs::rename(later / "d.tmp", later / "d.json");
+  });
+  const test::CommandResult follow = test::RunCli("recognize --db " + library_ + " --sequence " + later.string() +
+                                                  " --follow --idle-timeout 5 --out-json " + followed);
+  producer.join();
+  ASSERT_EQ(follow.exit_code, 0) << follow.output;
+  const std::vector<nlohmann::json> lines = lines_of(followed);
+  ASSERT_EQ(lines.size(), 1U) << follow.output;
+  EXPECT_FALSE(lines[0].contains("skipped_before"));
+  EXPECT_EQ(lines[0].at("detections").size(), 3U);
+  EXPECT_EQ(test::RunCli("recognize --db " + library_ + " --sequence " + later.string() + " --latest").exit_code, 2)
+      << "--latest without --follow";
 }
 
 TEST_F(RecognizeEndToEnd, BadInputIsReported) {

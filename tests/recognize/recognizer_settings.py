@@ -25,8 +25,9 @@ import tempfile
 
 # The flags of each front end that are not recognizer settings.
 OWN_FLAGS = {
-    "recognize": {"--help", "--db", "--models", "--sequence", "--follow", "--idle-timeout", "--out-json", "--out-bop",
-                  "--scene-id", "--image-id", "--overlay", "--color", "--depth", "--depth-scale", "--camera"},
+    "recognize": {"--help", "--db", "--models", "--sequence", "--follow", "--latest", "--idle-timeout", "--out-json",
+                  "--out-bop", "--scene-id", "--image-id", "--overlay", "--color", "--depth", "--depth-scale",
+                  "--camera"},
     "serve": {"--help", "--db", "--models", "--socket", "--max-clients", "--idle-timeout", "--root", "--socket-mode",
               "--max-request-bytes"},
     "recognize_bench": {"--help", "--db", "--lmo-db", "--peers", "--peers-only", "--object-pixels", "--bytes",
