@@ -199,6 +199,7 @@ class Stream:
         self.start = [None] * count  # the time each frame counts from (None: never sent)
         self.late = [0.0] * count  # how late each frame was fed (s)
         self.answers = {}  # frame -> (time, answer)
+        self.skipped = set()  # frames passed over for a newer one (recognize --latest)
         self.stopped_at = None
         self.ended = False  # standard output closed
         self.problem = None  # what went wrong feeding or reading
@@ -240,6 +241,7 @@ class Stream:
             with self.lock:
                 if self.stopped_at is None:
                     self.answers[frame] = (now, answer)
+                    self.skipped.update(range(frame - answer.get("skipped_before", 0), frame))
                     self.lock.notify()
         with self.lock:
             self.ended = True
@@ -255,13 +257,13 @@ class Stream:
         feeder.start()
         deadline = self.origin + (self.count - 1) / self.fps + drain
         with self.lock:
-            while (len(self.answers) < self.count and not self.ended and self.problem is None and
-                   time.perf_counter() < deadline):
+            while (len(self.answers) + len(self.skipped) < self.count and not self.ended and self.problem is None
+                   and time.perf_counter() < deadline):
                 self.lock.wait(0.1)
             self.stopped_at = time.perf_counter()
             self.stopping.set()
             problem = self.problem
-            if problem is None and self.ended and len(self.answers) < self.count:
+            if problem is None and self.ended and len(self.answers) + len(self.skipped) < self.count:
                 problem = f"ended after {len(self.answers)} of {self.count} answers"
         self.child.stop()
         feeder.join()
@@ -320,11 +322,14 @@ def percentile(values, p):
 
 def summary(streams):
     """The table cells of one or more streams: fed, answered, p50/95/99, searched, objects, recognizer ms."""
-    latencies, totals, searched, objects, fed, errors = [], [], 0, [], 0, 0
+    latencies, totals, searched, objects, fed, errors, skipped = [], [], 0, [], 0, 0, 0
     for stream in streams:
         for i in range(stream.count):
             answered = stream.answers.get(i)
             fed += 1
+            if i in stream.skipped:
+                skipped += 1
+                continue
             if answered is None:
                 latencies.append((1000 * (stream.stopped_at - stream.counts_from(i)), False))
                 continue
@@ -338,7 +343,8 @@ def summary(streams):
             searched += any(stage in timings for stage in SEARCH_STAGES) or "searched_frames_ago" in answer
             objects.append(len(answer.get("detections", [])))
     answered = len(totals) + errors
-    cells = [str(fed), str(answered) + (f" ({errors} errors)" if errors else "")]
+    cells = [str(fed), str(answered) + (f" ({errors} errors)" if errors else "") +
+             (f" ({skipped} skipped)" if skipped else "")]
     cells += [percentile(latencies, p) for p in (50, 95, 99)]
     cells += [f"{100 * searched / len(totals):.0f} %" if totals else "-",
               f"{statistics.mean(objects):.2f}" if objects else "-",
@@ -447,7 +453,8 @@ def main():
              f"is slower than the camera, and the wait counts; frames still unanswered {args.drain:g} s after the "
              f"last was due count with the time they had waited (≥: a percentile they may raise). Searched: the "
              f"answered frames in which models were searched (timings_ms has rank, ransac or point_pairs), or that a "
-             f"search beside the tracking joined (searched_frames_ago). The feed "
+             f"search beside the tracking joined (searched_frames_ago). Skipped: frames passed over for a newer one "
+             f"(recognize --latest), without a latency. The feed "
              f"was at most {late_ms:.1f} ms late. Configurations: "
              + "; ".join(f"{name}: `{shlex.join(flags)}`" for name, flags in configs) + ".", "",
              "| configuration | run | video | frames fed | answered | latency p50 ms | p95 ms | p99 ms | searched | "
