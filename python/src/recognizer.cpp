@@ -30,9 +30,9 @@ class StreamRecognizer {
   StreamRecognizer(std::shared_ptr<Library> library, const RecognizerSettings& settings)
       : library_(std::move(library)),
         settings_(settings),
-        recognizer_(library_->library(), ShareThreads(settings.options, settings.stream).track),
-        stream_(recognizer_, settings.stream,
-                MakeRecognizerFactory(library_->library(), ShareThreads(settings.options, settings.stream).search)) {}
+        threads_(ShareThreads(settings.options, settings.stream)),
+        recognizer_(library_->library(), threads_.track),
+        stream_(recognizer_, settings.stream, MakeRecognizerFactory(library_->library(), threads_.search)) {}
 
   RecognitionResult Recognize(const RgbdFrame& frame) {
     const std::lock_guard<std::mutex> lock(mutex_);
@@ -63,6 +63,7 @@ class StreamRecognizer {
  private:
   std::shared_ptr<Library> library_;  // the recognizer reads it
   RecognizerSettings settings_;
+  StreamRecognizerOptions threads_;  // the tracker's and the searcher's options, the threads shared out
   Recognizer recognizer_;
   RecognitionStream stream_;
   std::mutex mutex_;

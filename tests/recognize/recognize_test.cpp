@@ -372,16 +372,22 @@ TEST_F(RecognizeEndToEnd, ATrackDueForConfirmationIsSearchedAndConfirmedOnItsSur
   EXPECT_LT(TranslationDistance(due.detections[0].camera_from_object, truth->camera_from_object), 0.01);
 }
 
+// Options that report every pose and refine none: a wrong prior stays where it is put, and is reported.
+RecognizerOptions EveryPoseUnrefined() {
+  RecognizerOptions options;
+  options.verify.min_score = 0.0;
+  options.verify.min_visible_fraction = 0.0;
+  options.refine = false;
+  return options;
+}
+
 // A track that still verifies at a wrong place (here 20 cm beside the cracker box, with every pose reported) is
 // replaced when its confirming search finds the box where it is, with a higher score; until then it is followed. A
 // wrong first detection is replaced in the next frame, when its track is first confirmed.
 TEST_F(RecognizeEndToEnd, ATrackTheConfirmingSearchDisagreesWithIsReplaced) {
   const ModelLibrary library = Library({"003_cracker_box"});
   const LoadedFrame frame = LoadYcbvFrame(Frame());
-  RecognizerOptions options;
-  options.verify.min_score = 0.0;
-  options.verify.min_visible_fraction = 0.0;
-  options.refine = false;  // the wrong prior stays where it is put
+  const RecognizerOptions options = EveryPoseUnrefined();
   Recognizer recognizer(library, options);
   const GroundTruth* truth = TruthOf(frame, "003_cracker_box");
   ASSERT_NE(truth, nullptr);
@@ -422,10 +428,7 @@ TEST_F(RecognizeEndToEnd, ATrackTheConfirmingSearchDisagreesWithIsReplaced) {
 TEST_F(RecognizeEndToEnd, ASearchsDetectionGivenBesideATrackCompetesWithItAndConfirmsIt) {
   const ModelLibrary library = Library({"003_cracker_box"});
   const LoadedFrame frame = LoadYcbvFrame(Frame());
-  RecognizerOptions options;
-  options.verify.min_score = 0.0;
-  options.verify.min_visible_fraction = 0.0;
-  options.refine = false;  // the wrong prior stays where it is put
+  const RecognizerOptions options = EveryPoseUnrefined();
   ASSERT_EQ(options.max_instances, 1);
   Recognizer recognizer(library, options);
   const GroundTruth* truth = TruthOf(frame, "003_cracker_box");
