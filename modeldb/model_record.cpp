@@ -1,5 +1,8 @@
 #include "modeldb/model_record.h"
 
+#include <algorithm>
+#include <set>
+
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
@@ -96,7 +99,7 @@ FeatureSettings FeatureSettingsFromJson(const std::string& text, const std::stri
   return settings;
 }
 
-int BopObjectId(const std::string& name, int64_t library_id) {
+std::optional<int> DatasetObjectId(const std::string& name) {
   if (name.size() > 4 && name.size() <= 13 && name.rfind("obj_", 0) == 0 &&
       name.find_first_not_of("0123456789", 4) == std::string::npos) {
     return std::stoi(name.substr(4));
@@ -104,7 +107,32 @@ int BopObjectId(const std::string& name, int64_t library_id) {
   for (int id = 1; id <= 21; ++id) {
     if (YcbvClassName(id) == name) return id;
   }
-  return static_cast<int>(library_id);
+  return std::nullopt;
+}
+
+int BopObjectId(const std::string& name, int64_t library_id) {
+  return DatasetObjectId(name).value_or(static_cast<int>(library_id));
+}
+
+std::map<std::string, int> BopObjectIds(std::vector<std::pair<std::string, int64_t>> models) {
+  std::sort(models.begin(), models.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
+  std::map<std::string, int> ids;
+  std::set<int> taken;
+  auto claim = [&](const std::string& name, int id) {
+    if (ids.count(name) > 0 || taken.count(id) > 0) return;
+    ids[name] = id;
+    taken.insert(id);
+  };
+  // Dataset names claim their ids first, then the other models their library numbers; a model whose id is held
+  // gets the next number above all given, in library order.
+  for (const auto& [name, library_id] : models) {
+    if (const std::optional<int> id = DatasetObjectId(name)) claim(name, *id);
+  }
+  for (const auto& [name, library_id] : models) claim(name, static_cast<int>(library_id));
+  for (const auto& [name, library_id] : models) {
+    if (ids.count(name) == 0) claim(name, taken.empty() ? 1 : *taken.rbegin() + 1);
+  }
+  return ids;
 }
 
 int ModelRecord::NumPrimitives() const {

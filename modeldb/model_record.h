@@ -1,7 +1,10 @@
 #pragma once
 
+#include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -71,9 +74,16 @@ struct ModelRecord {
   std::string DescriptorSha256() const;
 };
 
-/// The BOP obj_id of a model: the number of a BOP name ("obj_000005": 5), the class index of a YCB-Video name
-/// ("003_cracker_box": 2), else its number in the library (`library_id`).
+/// The BOP obj_id a model asks for: the number of a BOP name ("obj_000005": 5), the class index of a YCB-Video
+/// name ("003_cracker_box": 2), else its number in the library (`library_id`).
 int BopObjectId(const std::string& name, int64_t library_id);
+/// The object number a BOP or YCB-Video name stands for ("obj_000005": 5, "003_cracker_box": 2); none for another name.
+std::optional<int> DatasetObjectId(const std::string& name);
+
+/// The BOP obj_id of every model of a library (name and library id, any order), one id per model: BopObjectId's,
+/// unless another model holds it. Dataset names claim their ids first, then the others their library numbers; a
+/// model whose id is held gets the next number above all given, in library id order.
+std::map<std::string, int> BopObjectIds(std::vector<std::pair<std::string, int64_t>> models);
 
 /// The mesh of a library model in the object frame (metres): the stored one (mesh_blob) when there is one, else
 /// its mesh file (mesh_path with the record's unit and object_from_mesh; missing textures tolerated, as in the

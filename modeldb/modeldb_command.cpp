@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -185,10 +186,17 @@ std::string PointPairsColumn(const ModelSummary& m) {
   return m.point_pair_points == 0 ? "refused" : std::to_string(m.point_pair_points);
 }
 
-nlohmann::ordered_json SummaryJson(const ModelSummary& m) {
+// The BOP obj_id of each model of the library (as recognize --out-bop writes them).
+std::map<std::string, int> LibraryObjectIds(const std::vector<ModelSummary>& models) {
+  std::vector<std::pair<std::string, int64_t>> named;
+  for (const ModelSummary& m : models) named.emplace_back(m.name, m.id);
+  return BopObjectIds(std::move(named));
+}
+
+nlohmann::ordered_json SummaryJson(const ModelSummary& m, int bop_object_id) {
   return {{"name", m.name},
           {"id", m.id},
-          {"bop_obj_id", BopObjectId(m.name, m.id)},
+          {"bop_obj_id", bop_object_id},
           {"mesh_path", m.mesh_path},
           {"mesh_sha256", m.mesh_sha256},
           {"unit", m.unit},
@@ -209,9 +217,10 @@ nlohmann::ordered_json SummaryJson(const ModelSummary& m) {
 int RunList(const ModeldbArgs& args) {
   const ModelDatabase database(args.db, OpenMode::kReadOnly);
   const std::vector<ModelSummary> models = database.ListModels();
+  const std::map<std::string, int> object_ids = LibraryObjectIds(models);
   if (args.json) {
     nlohmann::ordered_json list = nlohmann::ordered_json::array();
-    for (const ModelSummary& model : models) list.push_back(SummaryJson(model));
+    for (const ModelSummary& model : models) list.push_back(SummaryJson(model, object_ids.at(model.name)));
     std::cout << list.dump(2) << '\n';
     return kExitOk;
   }
@@ -221,7 +230,7 @@ int RunList(const ModeldbArgs& args) {
               "descriptors", "diameter_mm", "symmetric", "colour", "mesh_MB", "ppf_points", "created");
   for (const ModelSummary& m : models) {
     const std::string mesh = m.mesh_blob_bytes > 0 ? Fixed(m.mesh_blob_bytes / 1e6, 1) : "file";  // not stored
-    std::printf("%-28s %6d %6d %11d %12d %12.1f %9s %7s %8s %10s  %s\n", m.name.c_str(), BopObjectId(m.name, m.id),
+    std::printf("%-28s %6d %6d %11d %12d %12.1f %9s %7s %8s %10s  %s\n", m.name.c_str(), object_ids.at(m.name),
                 m.num_views, m.num_primitives, m.num_descriptors, 1000.0 * m.diameter_m, m.symmetric ? "yes" : "no",
                 m.has_color_matrix ? "yes" : "no", mesh.c_str(), PointPairsColumn(m).c_str(), m.created.c_str());
   }
@@ -235,7 +244,7 @@ int RunInfo(const ModeldbArgs& args) {
     std::cerr << "ecvpose: error: " << args.db << ": no model \"" << args.model << "\" (see `ecvpose modeldb list`)\n";
     return kExitBadInput;
   }
-  nlohmann::ordered_json json = SummaryJson(*model);
+  nlohmann::ordered_json json = SummaryJson(*model, LibraryObjectIds(database.ListModels()).at(model->name));
   if (const std::optional<ColorMatrixRecord> matrix = database.GetColorMatrix(args.model)) {
     const Eigen::Matrix3d& a = matrix->model_to_scene;
     json["color_matrix"] = {

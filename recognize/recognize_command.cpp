@@ -43,12 +43,10 @@ struct RecognizeArgs {
 };
 
 // The BOP obj_id of each model of the library (modeldb list shows them).
-std::map<std::string, int> BopObjectIds(const ModelLibrary& library) {
-  std::map<std::string, int> ids;
-  for (const LibraryModel& model : library.models()) {
-    ids[model.record.name] = BopObjectId(model.record.name, model.record.id);
-  }
-  return ids;
+std::map<std::string, int> LibraryObjectIds(const ModelLibrary& library) {
+  std::vector<std::pair<std::string, int64_t>> models;
+  for (const LibraryModel& model : library.models()) models.emplace_back(model.record.name, model.record.id);
+  return BopObjectIds(std::move(models));
 }
 
 // Scene and image ids of a frame: from --scene-id and --image-id (a single frame), else as the frame names them (a
@@ -135,7 +133,7 @@ int RecognizeOneFrame(const RecognizeArgs& args, const LoadedFrame& loaded, cons
   if (!args.out_bop.empty()) {
     std::ostringstream csv;
     csv << kBopHeader;
-    AppendBopRows(csv, BopIds(loaded, 0, args.scene_id, args.image_id), result, BopObjectIds(library));
+    AppendBopRows(csv, BopIds(loaded, 0, args.scene_id, args.image_id), result, LibraryObjectIds(library));
     if (args.out_bop == "-") {
       LineOutput("-", "--out-bop").Write(csv.str());
     } else {
@@ -160,7 +158,7 @@ int RecognizeSequence(const RecognizeArgs& args, FrameSource& feed, const ModelL
   std::ostream& report = Report(args);
   LineOutput lines(args.out_json, "--out-json"), csv(args.out_bop, "--out-bop");
   if (csv.active()) csv.Write(kBopHeader);
-  const std::map<std::string, int> object_ids = BopObjectIds(library);
+  const std::map<std::string, int> object_ids = LibraryObjectIds(library);
   int done = 0, failed = 0;
   double total_ms = 0.0;
   RecognitionStream stream(recognizer, args.recognizer.stream, MakeRecognizerFactory(library, search_options));

@@ -4,6 +4,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <variant>
@@ -38,6 +39,7 @@ class StreamRecognizer {
     const std::lock_guard<std::mutex> lock(mutex_);
     RecognitionResult result = stream_.Next(frame);
     last_timings_ms_ = result.timings_ms;
+    last_searched_frames_ago_ = result.searched_frames_ago;
     return result;
   }
 
@@ -49,6 +51,12 @@ class StreamRecognizer {
   std::map<std::string, double> last_timings_ms() {
     const std::lock_guard<std::mutex> lock(mutex_);
     return last_timings_ms_;
+  }
+
+  std::optional<int> last_searched_frames_ago() {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (last_searched_frames_ago_ < 0) return std::nullopt;
+    return last_searched_frames_ago_;
   }
 
   cv::Mat Draw(const RgbdFrame& frame, const std::vector<Detection>& detections) {
@@ -68,6 +76,7 @@ class StreamRecognizer {
   RecognitionStream stream_;
   std::mutex mutex_;
   std::map<std::string, double> last_timings_ms_;
+  int last_searched_frames_ago_ = -1;
 };
 
 // The Python Recognizer's default thread count (the CLI's: every core); the other defaults are the table's.
@@ -309,6 +318,9 @@ void BindRecognizer(py::module_& m) {
            "Forgets the tracks: the next frame searches every model (a new video).")
       .def_property_readonly("last_timings_ms", &StreamRecognizer::last_timings_ms,
                              "Time per stage of the last frame, milliseconds (\"total\": the whole call in C++).")
+      .def_property_readonly("last_searched_frames_ago", &StreamRecognizer::last_searched_frames_ago,
+                             "With search_beside: when a finished search's detections joined the last frame, how many "
+                             "frames before it the searched frame came; else None.")
       .def_property_readonly(
           "settings", [](const StreamRecognizer& recognizer) { return SettingsDict(recognizer.settings()); },
           "The keywords' values this recognizer runs with, {keyword: value}.")

@@ -1,4 +1,5 @@
-"""Shared fixtures: the demo data of the checkout and a library of its three meshes, built once per test file."""
+"""Shared fixtures: the demo data of the checkout and a library of its three meshes (ctest's, or built once per test
+file)."""
 
 import os
 import pathlib
@@ -15,7 +16,10 @@ DATA_DIR = pathlib.Path(os.environ.get("ECVPOSE_DATA_DIR", SOURCE_DIR.parent / "
 
 @pytest.fixture(scope="module")
 def demo_library_path(tmp_path_factory):
-    """The library of models/meshes as the demo builds it: 40 views at 0.9 m."""
+    """The library of models/meshes as the demo builds it: 40 views at 0.9 m. Under ctest, the one its demo_library
+    fixture built once for every test (ECV_DEMO_LIBRARY), which tests read and do not change."""
+    if "ECV_DEMO_LIBRARY" in os.environ:
+        return pathlib.Path(os.environ["ECV_DEMO_LIBRARY"])
     path = tmp_path_factory.mktemp("library") / "demo.sqlite"
     ecvpose.build_models(str(path), DEMO_MESHES, views=40, distance=0.9)
     return path

@@ -3,6 +3,7 @@
 import json
 import os
 import subprocess
+import time
 
 import numpy as np
 
@@ -45,3 +46,21 @@ def test_draw_marks_the_detections_and_write_image_writes_them(demo_library, dem
     path = tmp_path / "overlay.png"
     ecvpose.write_image(str(path), picture)
     assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_a_search_beside_the_tracking_brings_its_objects_into_a_later_call(demo_library, demo_frame):
+    recognizer = ecvpose.Recognizer(demo_library, track=True, search_beside=True, threads=2)
+    assert recognizer.recognize_frame(demo_frame) == []  # follows nothing yet; the searcher takes this frame
+    assert recognizer.last_searched_frames_ago is None
+    calls, deadline = 1, time.monotonic() + 120.0
+    while recognizer.last_searched_frames_ago is None and time.monotonic() < deadline:
+        time.sleep(0.03)  # a camera's interval
+        detections = recognizer.recognize_frame(demo_frame)
+        calls += 1
+    assert recognizer.last_searched_frames_ago == calls - 1  # the first call's frame was searched
+    names = {model.name for model in demo_library.models}
+    truth = {model: pose for model, pose in demo_frame.ground_truth if model in names}
+    assert sorted(d.model for d in detections) == sorted(truth)
+    for detection in detections:
+        error_m = np.linalg.norm(detection.camera_from_object[:3, 3] - truth[detection.model][:3, 3])
+        assert error_m < 0.01, (detection.model, error_m)

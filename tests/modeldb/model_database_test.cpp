@@ -113,6 +113,22 @@ TEST(BopObjectId, FromABopOrYcbVideoNameElseTheLibraryNumber) {
   EXPECT_EQ(BopObjectId("obj_", 9), 9);
 }
 
+// A library of YCB-Video objects and other models (e.g. scaled variants) numbered 1..n: no two models share an id.
+TEST(BopObjectId, EveryModelOfALibraryHasItsOwnIdAndDatasetNamesKeepTheirs) {
+  // 040_large_marker is YCB-Video's 18, which is also the variant's library number; obj_000002 asks for the
+  // cracker box's 2 and comes after it in the library.
+  const std::map<std::string, int> ids = BopObjectIds({{"variant_b", 18},
+                                                       {"040_large_marker", 30},
+                                                       {"mug", 4},
+                                                       {"003_cracker_box", 1},
+                                                       {"obj_000002", 2},
+                                                       {"variant_a", 2}});
+  const std::map<std::string, int> expected = {{"040_large_marker", 18}, {"003_cracker_box", 2}, {"mug", 4},
+                                               {"obj_000002", 19},       {"variant_a", 20},      {"variant_b", 21}};
+  EXPECT_EQ(ids, expected);
+  EXPECT_TRUE(BopObjectIds({}).empty());
+}
+
 TEST(ModelDatabase, RemovesAModelWithItsRows) {
   ModelDatabase database(":memory:", OpenMode::kCreate);
   database.AddModel(test::SyntheticModel("a", 3, 100, 1));

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -35,8 +36,14 @@ constexpr int kFoundAtLeast = 6;  // of 7: all but the banana of 0002 (with the 
 
 class YcbvLibrary : public ::testing::Test {
  protected:
+  // Under ctest, the library its ycbv_library fixture built once for every test (scripts/build_ycbv_library, the same
+  // models and flags); run alone, a library of its own. Tests read it and do not change it (copy it first).
   static void SetUpTestSuite() {
     directory_ = new test::TemporaryDirectory();
+    if (const char* shared = std::getenv("ECV_YCBV_LIBRARY")) {
+      library_ = shared;
+      return;
+    }
     library_ = directory_->File("ycbv.sqlite");
     const std::string data = test::DataPath("ycbv_subset");
     for (const auto& [name, object_from_mesh] : ReadTransformTable(data + "/derived/google16k_to_ycbv.txt")) {

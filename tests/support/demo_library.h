@@ -9,7 +9,8 @@
 namespace ecv::test {
 
 /// A test suite with the library of the three demo meshes in models/meshes (40 views at 0.9 m, as scripts/demo builds
-/// it), built once for the suite through the CLI, in a temporary directory the suite's tests may also write into.
+/// it): the one ctest's demo_library fixture built (ECV_DEMO_LIBRARY), else built once for the suite through the CLI.
+/// Tests read it and do not change it (copy it first); the suite's temporary directory is theirs to write into.
 class DemoLibrarySuite : public ::testing::Test {
  protected:
   static void SetUpTestSuite();
