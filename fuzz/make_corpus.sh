@@ -13,7 +13,7 @@ seeds() { ASAN_OPTIONS=detect_leaks=0 "$build/fuzz/ecv_fuzz_seeds" "$@"; }
 separator=$'\n--ecvfuzz-part--\n'  # fuzz_util.h's kPartSeparator
 rm -rf "$work"
 mkdir -p "$work"
-for target in png_frame frame_json ycbv_meta bop_scene pcd pose_json mesh_blob mesh serve_request; do
+for target in png_frame frame_json ycbv_meta bop_scene pcd pose_json mesh_blob mesh serve_request oni; do
   mkdir -p "$corpus/fuzz_$target"
 done
 
@@ -129,6 +129,9 @@ cp "$banana/textured_simple.obj.mtl" "$banana/texture_map.png" "$work/"
 sed -i 's|^mtllib .*|mtllib textured_simple.obj.mtl|' "$work/banana.obj"
 seeds mesh-blob "$work/banana.obj" "$corpus/fuzz_mesh_blob/seed-banana"
 seeds mesh-blob "$work/ape.ply" "$corpus/fuzz_mesh_blob/seed-ape"
+
+# ONI: two frames of YCB-Video video 0000, cropped to 16 x 12, as `ecvpose record` writes a recording.
+seeds oni "$ycbv/0000/000001-color.png" "$ycbv/0000/000001-depth.png" "$corpus/fuzz_oni/seed-ycbv.oni"
 
 # Serve requests: the lines of fuzz/corpus/serve_request (tests/recognize/serve_request_test.cpp runs the target over
 # them in every ctest run).

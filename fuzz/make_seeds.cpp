@@ -1,12 +1,13 @@
 // The binary seeds of make_corpus.sh, made from real files: small crops of a frame and of an organized cloud, a
 // YCB-Video meta trimmed to the variables LoadYcbvFrame reads, a trimmed mesh in the formats no real file of ours
-// has, and a stored mesh blob.
+// has, a stored mesh blob and an ONI recording.
 //
 //   ecv_fuzz_seeds png-pair COLOR.png DEPTH.png OUT     32 x 24 crops joined by kPartSeparator
 //   ecv_fuzz_seeds ycbv-meta META.mat OUT_DIR           MATLAB v5, v5 compressed and v7.3 (HDF5)
 //   ecv_fuzz_seeds pcd CLOUD.pcd OUT_DIR                a 16 x 12 crop (or 192 points) as ascii, binary, compressed
 //   ecv_fuzz_seeds mesh-formats MESH OUT_DIR            fuzz_mesh inputs: extension digit, then the file
 //   ecv_fuzz_seeds mesh-blob MESH OUT                   EncodeMeshBlob with textures capped at 8 pixels
+//   ecv_fuzz_seeds oni COLOR.png DEPTH.png OUT          an ONI recording of two 16 x 12 crops (OniWriter)
 
 #include <matio.h>
 
@@ -25,7 +26,9 @@
 #include <assimp/Importer.hpp>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
+#include "camera/oni_writer.h"
 #include "fuzz_util.h"
 #include "io/mesh_blob.h"
 #include "io/mesh_io.h"
@@ -171,6 +174,26 @@ void MeshBlob(const std::string& path, const std::string& out) {
   ecv::fuzz::WriteFile(out, std::string(blob.begin(), blob.end()));
 }
 
+// Two frames (a crop of the real frame, then the crop next to it) in 1 mm depth units, as `ecvpose record` writes them.
+void Oni(const std::string& color_path, const std::string& depth_path, const std::string& out) {
+  const cv::Mat color = cv::imread(color_path, cv::IMREAD_COLOR);
+  const cv::Mat depth = cv::imread(depth_path, cv::IMREAD_UNCHANGED);
+  if (color.empty() || depth.type() != CV_16UC1)
+    throw std::runtime_error("cannot read " + color_path + " or " + depth_path);
+  ecv::OniWriterOptions options;
+  options.width = 16;
+  options.height = 12;
+  options.depth_unit = ecv::OniDepthUnit::kMillimetre;
+  ecv::OniWriter writer(out, options);
+  for (const int shift : {0, 16}) {
+    const cv::Rect crop(color.cols / 2 - 8 + shift, color.rows / 2 - 6, 16, 12);
+    cv::Mat rgb;
+    cv::cvtColor(color(crop), rgb, cv::COLOR_BGR2RGB);
+    writer.Write(rgb, depth(crop) / 10);  // YCB-Video's 100 um units to millimetres
+  }
+  writer.Finish();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -186,6 +209,8 @@ int main(int argc, char** argv) {
       MeshFormats(args[1], args[2]);
     } else if (args.size() == 3 && args[0] == "mesh-blob") {
       MeshBlob(args[1], args[2]);
+    } else if (args.size() == 4 && args[0] == "oni") {
+      Oni(args[1], args[2], args[3]);
     } else {
       std::cerr << "usage: see the comment at the top of fuzz/make_seeds.cpp\n";
       return 2;
