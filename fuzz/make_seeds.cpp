@@ -178,8 +178,9 @@ void MeshBlob(const std::string& path, const std::string& out) {
 void Oni(const std::string& color_path, const std::string& depth_path, const std::string& out) {
   const cv::Mat color = cv::imread(color_path, cv::IMREAD_COLOR);
   const cv::Mat depth = cv::imread(depth_path, cv::IMREAD_UNCHANGED);
-  if (color.empty() || depth.type() != CV_16UC1)
+  if (color.empty() || depth.type() != CV_16UC1) {
     throw std::runtime_error("cannot read " + color_path + " or " + depth_path);
+  }
   ecv::OniWriterOptions options;
   options.width = 16;
   options.height = 12;

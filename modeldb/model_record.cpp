@@ -72,6 +72,18 @@ void RejectUnknown(const nlohmann::json& object, const nlohmann::ordered_json& k
   }
 }
 
+// The object number a BOP or YCB-Video name stands for ("obj_000005": 5, "003_cracker_box": 2); none for another name.
+std::optional<int> DatasetObjectId(const std::string& name) {
+  if (name.size() > 4 && name.size() <= 13 && name.rfind("obj_", 0) == 0 &&
+      name.find_first_not_of("0123456789", 4) == std::string::npos) {
+    return std::stoi(name.substr(4));
+  }
+  for (int id = 1; id <= 21; ++id) {
+    if (YcbvClassName(id) == name) return id;
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 std::string FeatureSettingsToJson(const FeatureSettings& settings) {
@@ -97,17 +109,6 @@ FeatureSettings FeatureSettingsFromJson(const std::string& text, const std::stri
     Read(group == "ecv" ? ecv : descriptor, key, &field, source);
   });
   return settings;
-}
-
-std::optional<int> DatasetObjectId(const std::string& name) {
-  if (name.size() > 4 && name.size() <= 13 && name.rfind("obj_", 0) == 0 &&
-      name.find_first_not_of("0123456789", 4) == std::string::npos) {
-    return std::stoi(name.substr(4));
-  }
-  for (int id = 1; id <= 21; ++id) {
-    if (YcbvClassName(id) == name) return id;
-  }
-  return std::nullopt;
 }
 
 int BopObjectId(const std::string& name, int64_t library_id) {

@@ -76,9 +76,8 @@ struct ModelRecord {
 
 /// The BOP obj_id a model asks for: the number of a BOP name ("obj_000005": 5), the class index of a YCB-Video
 /// name ("003_cracker_box": 2), else its number in the library (`library_id`).
+/// Two models may ask for the same id: a library's ids come from BopObjectIds.
 int BopObjectId(const std::string& name, int64_t library_id);
-/// The object number a BOP or YCB-Video name stands for ("obj_000005": 5, "003_cracker_box": 2); none for another name.
-std::optional<int> DatasetObjectId(const std::string& name);
 
 /// The BOP obj_id of every model of a library (name and library id, any order), one id per model: BopObjectId's,
 /// unless another model holds it. Dataset names claim their ids first, then the others their library numbers; a
