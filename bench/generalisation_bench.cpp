@@ -32,6 +32,7 @@
 #include "generalisation_set.h"
 #include "modeldb/model_library.h"
 #include "recognize/evaluation.h"
+#include "recognize/recognition_json.h"
 #include "recognize/recognition_stream.h"
 #include "recognize/recognizer.h"
 #include "recognize/settings_flags.h"
@@ -354,7 +355,7 @@ int Main(int argc, char** argv) {
   app.add_option("--detections", s.detections,
                  "JSON Lines file every run's detections are appended to, per frame with their verification terms "
                  "and which were right, with each found or wrongly placed object's pose errors");
-  s.recognizer.options.ransac.threads = 2;  // the benchmark machine's cores
+  s.recognizer.options.threads = 2;  // the benchmark machine's cores
   AddSettingFlags(app, &s.recognizer, {"hypotheses", "track", "search-beside"},
                   "Settings of every run (as `ecvpose recognize` takes them)");
   if (const auto exit_code = ParseCommandLine(app, argc, argv)) return *exit_code;
@@ -405,7 +406,7 @@ int Main(int argc, char** argv) {
     for (const BenchFrame& frame : frames) ++per_set[frame.set];
     text << "The " << SplitHalfName(half) << " half: " << per_set["rendered"] << " rendered scenes, "
          << per_set["composite"] << " composites, " << per_set["cast"] << " cast frames; library of "
-         << library.models().size() << " models (`" << s.db << "`), " << s.recognizer.options.ransac.threads
+         << library.models().size() << " models (`" << s.db << "`), " << s.recognizer.options.threads
          << " threads. Generating took " << Fixed(generate_s, 0) << " s, " << runs.size() << " of " << planned
          << " runs " << Fixed(total_s / 60.0, 1) << " min in all.\n\n"
          << ConditionTable(runs, frames) << "\nWhere the false positives lie (nearest object within 6 cm; the "

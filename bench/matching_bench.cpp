@@ -24,6 +24,7 @@
 #include "ecv/primitives.h"
 #include "modeldb/model_library.h"
 #include "recognize/recognizer.h"
+#include "recognize/scene.h"
 
 namespace ecv::bench {
 namespace {
@@ -103,7 +104,7 @@ std::pair<std::vector<Primitive>, Descriptors> SceneDescriptors(const ModelLibra
   const FeatureSettings& settings = library.feature_settings();
   std::vector<Primitive> primitives = ExtractPrimitives(frame, settings.ecv).primitives;
   RecognizerOptions options;
-  options.ransac.threads = 1;
+  options.threads = 1;
   Descriptors descriptors = ComputeSceneDescriptors(primitives, settings.descriptor, options);
   return {std::move(primitives), std::move(descriptors)};
 }

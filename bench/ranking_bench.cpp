@@ -140,7 +140,7 @@ std::string Run(const ModelLibrary& library, const RecognizerOptions& options, c
 int Main(int argc, char** argv) {
   std::string db, results = std::string(ECV_SOURCE_DIR) + "/bench/RESULTS.md";
   RecognizerOptions options;
-  options.ransac.threads = 1;
+  options.threads = 1;
   bool lmo = false;
   CLI::App app{
       "ranking_bench: view ranking against the ground truth: do the library views the recognizer tries "

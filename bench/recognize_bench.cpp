@@ -494,7 +494,7 @@ LibraryRuns RunAll(const std::string& db, const std::vector<NamedFrame>& frames,
     for (const int threads : methods.threads) {
       if (threads <= 1) continue;
       RecognizerOptions threaded = options;
-      threaded.ransac.threads = threads;
+      threaded.threads = threads;
       const std::string label = "ECV + RANSAC + ICP, " + std::to_string(threads) + " threads";
       runs.emplace_back(label, RunRecognizer(library, threaded, frames, models, "threads"));
       *notes << label << ": detections " << (SameDetections(runs.front().second, runs.back().second) ? "" : "NOT ")

@@ -131,7 +131,7 @@ def main():
     rec.add_argument("out")
     rec.add_argument("--db", required=True)
     rec.add_argument("--lmo-db", required=True)
-    rec.add_argument("--ecvpose", default=os.path.join(ROOT, "build", "src", "app", "ecvpose"))
+    rec.add_argument("--ecvpose", default=os.path.join(ROOT, "build", "app", "ecvpose"))
     rec.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
     rec.add_argument("--threads", type=int, default=2)
     cmp = commands.add_parser("compare")

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """`ecvpose serve` against one-shot `ecvpose recognize` per frame: what keeping the library loaded saves.
 
-    bench/serve_bench.py --db LIB [--cli build/src/app/ecvpose] [--data ../shared/data] [--results FILE]
+    bench/serve_bench.py --db LIB [--cli build/app/ecvpose] [--data ../shared/data] [--results FILE]
 
 Over the 30 YCB-Video frames (videos 0000-0002), frame by frame, one thread: the wall time of a one-shot
 `recognize` process per frame (library and meshes loaded each time), and of each request answered by one `serve`
@@ -52,7 +52,7 @@ def served(cli, db, frames):
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--db", required=True)
-    parser.add_argument("--cli", default=str(HERE.parent / "build" / "src" / "app" / "ecvpose"))
+    parser.add_argument("--cli", default=str(HERE.parent / "build" / "app" / "ecvpose"))
     parser.add_argument("--data", default=str(HERE.parent.parent / "shared" / "data"))
     parser.add_argument("--results", default=str(HERE / "RESULTS.md"))
     args = parser.parse_args()

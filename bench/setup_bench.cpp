@@ -90,7 +90,7 @@ void RunVariant(const Settings& settings, const std::string& path, const ecv::Lo
   for (const ecv::LibraryModel& model : library.models()) triangles += ecv::ModelMesh(model.record).NumTriangles();
   times->meshes.push_back(MillisecondsSince(start));
   ecv::RecognizerOptions options;
-  options.ransac.threads = settings.threads;
+  options.threads = settings.threads;
   start = Clock::now();
   ecv::Recognizer recognizer(library, options);
   times->setup.push_back(MillisecondsSince(start));

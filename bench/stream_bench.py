@@ -3,7 +3,7 @@
 --sequence DIR --follow` (frame JSONs written into DIR) and to `ecvpose serve` (tracked requests on its standard input).
 
     bench/stream_bench.py --db LIB [--seconds 60] [--fps 30] [--config NAME="FLAGS"]... [--videos 0000 0001 0002]
-        [--runs follow serve] [--frames-limit N] [--drain 10] [--cli build/src/app/ecvpose] [--results FILE]
+        [--runs follow serve] [--frames-limit N] [--drain 10] [--cli build/app/ecvpose] [--results FILE]
 
 Each configuration's FLAGS go to both commands (default: "track" = --track, "search every 3" = --track
 --search-every 3, "search beside" = --track --search-beside); `recognize` also gets --follow --track --out-json -,
@@ -367,7 +367,7 @@ def parse_args():
                         help="at most N frames per video and run, for a short check (default 0: --seconds x --fps)")
     parser.add_argument("--drain", type=float, default=10.0,
                         help="seconds to wait for answers after the last frame was due (default 10)")
-    parser.add_argument("--cli", default=str(HERE.parent / "build" / "src" / "app" / "ecvpose"), help="ecvpose")
+    parser.add_argument("--cli", default=str(HERE.parent / "build" / "app" / "ecvpose"), help="ecvpose")
     parser.add_argument("--data", default=os.environ.get("ECVPOSE_DATA_DIR", str(HERE.parent.parent / "shared" /
                                                                                  "data")), help="the shared data")
     parser.add_argument("--results", default=str(HERE / "RESULTS.md"), help="markdown file whose section is replaced")

@@ -7,7 +7,7 @@
 #include <string>
 
 #include "camera/openni_camera.h"
-#include "recognize/frame_source.h"
+#include "io/frame_source.h"
 
 namespace ecv {
 

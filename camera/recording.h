@@ -7,7 +7,7 @@
 
 #include "camera/oni_writer.h"
 #include "core/camera.h"
-#include "recognize/frame_source.h"
+#include "io/frame_source.h"
 
 namespace ecv {
 

@@ -7,7 +7,7 @@ install(TARGETS ${ecv_libraries} ecvpose
         RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
-# The viewer, beside ecvpose, which it starts (camera/view/).
+# The viewer, beside ecvpose, which it starts (app/view/).
 install(TARGETS ecvpose-view RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 # The mesh importer program, in the folder where LoadMesh looks for it (io/mesh_io.cpp).
 install(TARGETS ecvpose-mesh-import RUNTIME DESTINATION ${CMAKE_INSTALL_LIBDIR}/ecvpose)

@@ -46,7 +46,7 @@ cv::Mat DrawDetectionOverlay(Renderer& renderer, const std::vector<SceneObject>&
     char label[160];
     // Point pair poses are marked: they come from shape alone.
     std::snprintf(label, sizeof(label), "%s %.2f%s", detection.model.c_str(), detection.score,
-                  detection.hypothesis == HypothesisSource::kPpf ? " (ppf)" : "");
+                  detection.hypothesis_source == HypothesisSource::kPpf ? " (ppf)" : "");
     cv::putText(picture, label, at, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 3, cv::LINE_AA);
     cv::putText(picture, label, at, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
   }

@@ -5,7 +5,7 @@
 #include <opencv2/core.hpp>
 
 #include "core/frame.h"
-#include "recognize/recognizer.h"
+#include "recognize/detection.h"
 #include "render/renderer.h"
 
 namespace ecv {

@@ -9,7 +9,7 @@
 #include "core/pose.h"
 #include "modeldb/model_library.h"
 #include "modeldb/model_record.h"
-#include "recognize/recognizer.h"
+#include "recognize/detection.h"
 
 namespace ecv {
 

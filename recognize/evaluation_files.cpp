@@ -13,6 +13,7 @@
 #include "io/frame_io.h"
 #include "io/pose_io.h"
 #include "recognize/evaluation.h"
+#include "recognize/recognition_json.h"
 
 namespace ecv {
 namespace {

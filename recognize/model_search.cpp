@@ -173,8 +173,8 @@ void ModelSearch::Try(ViewCandidate* candidate, StageTimes* times) const {
   times->Add(Stage::kVerify, MillisecondsSince(stage));
 }
 
-std::optional<Verified> ModelSearch::BestPose(int count, int give_up_after, const cv::Mat& covered,
-                                              std::vector<ViewCandidate>* ranked, StageTimes* times) const {
+std::optional<VerifiedPose> ModelSearch::BestPose(int count, int give_up_after, const cv::Mat& covered,
+                                                  std::vector<ViewCandidate>* ranked, StageTimes* times) const {
   const ViewCandidate* best_view = nullptr;
   for (size_t i = 0; i < std::min(ranked->size(), static_cast<size_t>(count)); ++i) {
     if (give_up_after > 0 && i == static_cast<size_t>(give_up_after) &&
@@ -190,7 +190,7 @@ std::optional<Verified> ModelSearch::BestPose(int count, int give_up_after, cons
     if (options_.good_enough_score > 0.0 && best_view->verified->search_score >= options_.good_enough_score) break;
   }
   if (best_view == nullptr) return std::nullopt;
-  std::optional<Verified> best = best_view->verified;
+  std::optional<VerifiedPose> best = best_view->verified;
   if (!options_.refine) return best;
 
   // Of a bottle's front and back, coarse poses that score alike, the one ICP refines usually wins: both are refined.
@@ -202,10 +202,10 @@ std::optional<Verified> ModelSearch::BestPose(int count, int give_up_after, cons
     Refine(view->verified->depth, &refined);
     times->Add(Stage::kRefine, MillisecondsSince(stage));
     stage = Clock::now();
-    Verified verified = verify_(refined);
+    VerifiedPose verified = verify_(refined);
     times->Add(Stage::kVerify, MillisecondsSince(stage));
     // A refined pose is kept only if ICP did not lower its score.
-    const Verified& pose = verified.detection.score >= view->verified->detection.score ? verified : *view->verified;
+    const VerifiedPose& pose = verified.detection.score >= view->verified->detection.score ? verified : *view->verified;
     if (view == best_view || pose.detection.score > best->detection.score) best = pose;
   }
   return best;

@@ -11,7 +11,7 @@
 #include <opencv2/core.hpp>
 
 #include "modeldb/model_record.h"
-#include "recognize/recognizer.h"
+#include "recognize/detection.h"
 #include "recognize/scene.h"
 
 namespace ecv {
@@ -25,7 +25,7 @@ struct Hypothesis {
 
 /// A verified pose: the detection, the frame pixels (at dense_stride_px) where its rendered surface lies on the
 /// scene's, which overlap suppression compares, and the rendered depth, from which ICP takes the model's surface.
-struct Verified {
+struct VerifiedPose {
   Detection detection;
   /// The score without the continuation factor, by which the search chooses among coarse poses: before ICP a pose is
   /// often a few pixels off, and its outline then lies on its own object's surface.
@@ -35,7 +35,7 @@ struct Verified {
 };
 
 /// Renders, measures and scores a pose of the searched model (Recognizer's verification).
-using VerifyPose = std::function<Verified(const Hypothesis&)>;
+using VerifyPose = std::function<VerifiedPose(const Hypothesis&)>;
 
 /// A model view ranked by its consistent correspondences; once tried, its RANSAC pose, verified.
 struct ViewCandidate {
@@ -46,7 +46,7 @@ struct ViewCandidate {
   bool matched = false;
   bool tried = false;  ///< RANSAC ran on it (and `verified` is its pose, if any)
   std::optional<Hypothesis> hypothesis;
-  std::optional<Verified> verified;
+  std::optional<VerifiedPose> verified;
 };
 
 /// Searches one model in one scene. Holds references only: `record`, `options`, `scene` must outlive it.
@@ -67,8 +67,8 @@ class ModelSearch {
   /// first `give_up_after` show none at give_up_below_score; 0: never give up): RANSAC per view, each pose verified
   /// (once per view and frame, kept in `ranked`); of those not lying mostly (max_overlap) on `covered` pixels, the
   /// best and its turned rival refined by ICP and verified again, the better kept. Adds stage times.
-  std::optional<Verified> BestPose(int count, int give_up_after, const cv::Mat& covered,
-                                   std::vector<ViewCandidate>* ranked, StageTimes* times) const;
+  std::optional<VerifiedPose> BestPose(int count, int give_up_after, const cv::Mat& covered,
+                                       std::vector<ViewCandidate>* ranked, StageTimes* times) const;
 
   /// Point-to-plane ICP of the model's surface as rendered at the pose (`rendered_depth`, at dense_stride_px)
   /// against the scene points near it; the pose is kept when ICP fails.

@@ -1,4 +1,4 @@
-#include "recognize/recognizer.h"
+#include "recognize/recognition_json.h"
 
 #include "core/error.h"
 #include "io/pose_io.h"
@@ -24,7 +24,7 @@ nlohmann::json RecognitionToJson(const RecognitionResult& result) {
                           {"edge_pixels", d.edge_pixels},
                           {"tracked", d.tracked},
                           {"confirmed", d.confirmed},
-                          {"hypothesis", HypothesisSourceName(d.hypothesis)}});
+                          {"hypothesis", HypothesisSourceName(d.hypothesis_source)}});
   }
   nlohmann::json json = {{"detections", detections},
                          {"timings_ms", result.timings_ms},
@@ -54,7 +54,7 @@ std::vector<Detection> DetectionsFromJson(const nlohmann::json& json, const std:
       if (!hypothesis.is_string() || hypothesis == "both") {
         ThrowInputError(source, field + ".hypothesis", "\"context\" or \"ppf\"", hypothesis.dump());
       }
-      detection.hypothesis = ParseHypothesisSource(hypothesis.get<std::string>(), source + " " + field);
+      detection.hypothesis_source = ParseHypothesisSource(hypothesis.get<std::string>(), source + " " + field);
     }
     detections.push_back(detection);
   }

@@ -5,6 +5,7 @@
 
 #include "core/error.h"
 #include "io/frame_io.h"
+#include "recognize/recognition_json.h"
 
 namespace ecv {
 namespace {

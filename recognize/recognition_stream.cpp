@@ -26,9 +26,9 @@ void StreamOptions::Check() const {
 StreamRecognizerOptions ShareThreads(const RecognizerOptions& options, const StreamOptions& stream) {
   StreamRecognizerOptions shared{options, options};
   if (stream.search_beside) {
-    const int threads = options.ransac.threads;
-    shared.track.ransac.threads = std::max(1, threads - threads / 2);
-    shared.search.ransac.threads = std::max(1, threads / 2);
+    const int threads = options.threads;
+    shared.track.threads = std::max(1, threads - threads / 2);
+    shared.search.threads = std::max(1, threads / 2);
   }
   return shared;
 }

@@ -59,6 +59,17 @@ bool OneColoured(const TriangleMesh& mesh) {
   return true;
 }
 
+// A library model as the recognizer holds it.
+struct LoadedModel {
+  ModelRecord record;  // the library's, its colours mapped by its colour matrix if any
+  MeshId mesh;
+  RenderOptions render;                 // shaded as its library views are
+  std::optional<PpfModel> point_pairs;  // with point pair hypotheses: its table, if any
+  std::string point_pair_refusal;       // without a table: why
+  bool plain = false;                   // painted in one colour alone (VerifyOptions::plain_appearance)
+  PrincipalBox axes;                    // about which its poses are turned (TwinOptions)
+};
+
 RendererOptions VerificationRenderer(const RecognizerOptions& options) {
   options.Check();  // before anything is made of them
   RendererOptions renderer;
@@ -74,38 +85,29 @@ class Recognizer::Impl {
       : library_(library), options_(options), renderer_(VerificationRenderer(options)) {
     if (library.models().empty()) ThrowInputError("model library", "models", "at least one model", "none");
     options_.match.k = 1;
-    const std::vector<LibraryModel>& models = library_.models();
-    records_.resize(models.size());
+    const std::vector<LibraryModel>& library_models = library_.models();
+    models_.resize(library_models.size());
     // Colour mapping, stored meshes (or mesh files) and texture decoding on every thread, a batch of models at a time
     // (only a batch's meshes are held at once); the GL uploads on this thread, whose GL context it is.
-    const size_t batch = static_cast<size_t>(options_.ransac.threads);
-    std::vector<char> closed(models.size(), 0);  // per model: TriangleMesh::IsClosedOutward
-    ppf_models_.resize(models.size());
-    ppf_refusals_.resize(models.size());
-    plain_.resize(models.size());
-    axes_.resize(models.size());
+    const size_t batch = static_cast<size_t>(options_.threads);
     const bool point_pairs = options_.point_pairs.source != HypothesisSource::kContext;
-    for (size_t first = 0; first < models.size(); first += batch) {
-      std::vector<TriangleMesh> meshes(std::min(batch, models.size() - first));
-      ParallelFor(meshes.size(), options_.ransac.threads, [&](size_t i) {
-        records_[first + i] = PreparedRecord(models[first + i]);
-        meshes[i] = ModelMesh(models[first + i].record);
-        records_[first + i].mesh_blob = {};  // the copy's bytes: the renderer holds the mesh
-        closed[first + i] = meshes[i].IsClosedOutward() ? 1 : 0;
-        plain_[first + i] = OneColoured(meshes[i]) ? 1 : 0;
-        axes_[first + i] = meshes[i].PrincipalAxesBox();
-        if (point_pairs) {
-          ppf_models_[first + i] = MakePointPairModel(models[first + i].record, meshes[i], &ppf_refusals_[first + i]);
-        }
+    for (size_t first = 0; first < models_.size(); first += batch) {
+      std::vector<TriangleMesh> meshes(std::min(batch, models_.size() - first));
+      ParallelFor(meshes.size(), options_.threads, [&](size_t i) {
+        const LibraryModel& source = library_models[first + i];
+        LoadedModel& model = models_[first + i];
+        model.record = PreparedRecord(source);
+        meshes[i] = ModelMesh(source.record);
+        model.record.mesh_blob = {};  // the copy's bytes: the renderer holds the mesh
+        model.render.shading = StoredViewShading(source.record.build_options_json);
+        model.render.cull_back_faces = options_.verify.cull_back_faces && meshes[i].IsClosedOutward();
+        model.plain = OneColoured(meshes[i]);
+        model.axes = meshes[i].PrincipalAxesBox();
+        if (point_pairs) model.point_pairs = MakePointPairModel(source.record, meshes[i], &model.point_pair_refusal);
       });
-      for (const TriangleMesh& mesh : meshes) meshes_.push_back(renderer_.AddMesh(mesh));
+      for (size_t i = 0; i < meshes.size(); ++i) models_[first + i].mesh = renderer_.AddMesh(meshes[i]);
     }
-    for (size_t m = 0; m < models.size(); ++m) {
-      model_names_.push_back(models[m].record.name);
-      RenderOptions& render = render_options_.emplace_back();
-      render.shading = StoredViewShading(models[m].record.build_options_json);
-      render.cull_back_faces = options_.verify.cull_back_faces && closed[m] != 0;
-    }
+    for (const LoadedModel& model : models_) model_names_.push_back(model.record.name);
   }
 
   std::map<std::string, std::vector<RankedView>> RankViews(const RgbdFrame& frame) {
@@ -113,15 +115,15 @@ class Recognizer::Impl {
     Scene scene = PrepareScene(frame, options_);
     StageTimes unused;
     DescribeScene(library_.feature_settings(), options_, &scene, &unused);
-    std::vector<std::vector<ViewCandidate>> scored(records_.size());
-    ParallelFor(records_.size(), options_.ransac.threads,
-                [&](size_t m) { scored[m] = Search(m, scene, 1).RankViews(); });
+    std::vector<std::vector<ViewCandidate>> scored(models_.size());
+    ParallelFor(models_.size(), options_.threads, [&](size_t m) { scored[m] = Search(m, scene, 1).RankViews(); });
     std::map<std::string, std::vector<RankedView>> ranked;
-    for (size_t m = 0; m < records_.size(); ++m) {
-      std::vector<RankedView>& views = ranked[records_[m].name];
+    for (size_t m = 0; m < models_.size(); ++m) {
+      std::vector<RankedView>& views = ranked[models_[m].record.name];
       for (const ViewCandidate& candidate : scored[m]) {
         RankedView view{candidate.view, candidate.score, {}};
-        const std::vector<Primitive>& primitives = records_[m].views[static_cast<size_t>(candidate.view)].primitives;
+        const std::vector<Primitive>& primitives =
+            models_[m].record.views[static_cast<size_t>(candidate.view)].primitives;
         for (const Correspondence& c : candidate.correspondences) {
           view.correspondences.emplace_back(primitives[static_cast<size_t>(c.object)],
                                             scene.primitives[static_cast<size_t>(c.scene)]);
@@ -160,21 +162,21 @@ class Recognizer::Impl {
     // Fewer models to search than workers (a one-model library, say): the spare ones share each RANSAC's blocks.
     const auto to_search =
         static_cast<int>(std::count_if(models.begin(), models.end(), [](const ModelInFrame& m) { return m.search; }));
-    const int ransac_threads = std::max(1, options_.ransac.threads / std::max(1, to_search));
+    const int ransac_threads = std::max(1, options_.threads / std::max(1, to_search));
     std::vector<ModelSearchResult> searches(models.size());
     if (context) {
-      ParallelFor(models.size(), options_.ransac.threads, [&](size_t m) {
+      ParallelFor(models.size(), options_.threads, [&](size_t m) {
         if (models[m].search) searches[m] = SearchModel(m, scene, ransac_threads, &models[m]);
       });
     }
     if (options_.point_pairs.source != HypothesisSource::kContext) SearchByPointPairs(scene, &models, &times);
-    std::vector<Verified> candidates;
+    std::vector<VerifiedPose> candidates;
     for (size_t m = 0; m < models.size(); ++m) {
       MergeConfirmation(frame.depth.size(), options_.max_overlap, options_.max_instances, options_.dense_stride_px,
                         &models[m]);
       times += searches[m].times;
-      if (searches[m].views_tried >= 0) result.views_tried[records_[m].name] = searches[m].views_tried;
-      for (Verified& verified : models[m].instances) candidates.push_back(std::move(verified));
+      if (searches[m].views_tried >= 0) result.views_tried[models_[m].record.name] = searches[m].views_tried;
+      for (VerifiedPose& verified : models[m].instances) candidates.push_back(std::move(verified));
     }
     const Clock::time_point stage = Clock::now();
     result.detections = SuppressOverlaps(frame.depth.size(), std::move(candidates));
@@ -188,9 +190,10 @@ class Recognizer::Impl {
 
   std::vector<std::string> PointPairWarnings() const {
     std::vector<std::string> warnings;
-    for (size_t m = 0; m < ppf_refusals_.size(); ++m) {
-      if (!ppf_refusals_[m].empty()) {
-        warnings.push_back("model " + records_[m].name + ": no point pair hypotheses (" + ppf_refusals_[m] + ")");
+    for (const LoadedModel& model : models_) {
+      if (!model.point_pair_refusal.empty()) {
+        warnings.push_back("model " + model.record.name + ": no point pair hypotheses (" + model.point_pair_refusal +
+                           ")");
       }
     }
     return warnings;
@@ -204,7 +207,7 @@ class Recognizer::Impl {
 
   ModelSearch Search(size_t model, const Scene& scene, int ransac_threads) {
     return ModelSearch(
-        records_[model], options_, scene,
+        models_[model].record, options_, scene,
         [this, model, &scene](const Hypothesis& hypothesis) { return Verify(model, scene, hypothesis); },
         ransac_threads);
   }
@@ -212,11 +215,11 @@ class Recognizer::Impl {
   // Each model's priors tried at their poses (Track), the models on the workers, the best of them kept
   // (KeepBestFollowed); a prior that fails makes its model lost.
   void FollowPriors(const Scene& scene, std::vector<ModelInFrame>* models) {
-    ParallelFor(models->size(), options_.ransac.threads, [&](size_t m) {
+    ParallelFor(models->size(), options_.threads, [&](size_t m) {
       ModelInFrame& model = (*models)[m];
       std::vector<Followed> followed;
       for (const Detection* prior : model.priors) {
-        Verified tracked = Track(m, *prior, scene);
+        VerifiedPose tracked = Track(m, *prior, scene);
         if (Accepted(tracked.detection)) {
           followed.push_back({std::move(tracked), !prior->tracked});
         } else {
@@ -236,7 +239,7 @@ class Recognizer::Impl {
       if ((*models)[m].search) candidates.push_back(m);
     }
     std::vector<int> quick(candidates.size(), 0);
-    ParallelFor(candidates.size(), options_.ransac.threads,
+    ParallelFor(candidates.size(), options_.threads,
                 [&](size_t i) { quick[i] = Search(candidates[i], scene, 1).QuickScore(); });
     std::vector<size_t> order(candidates.size());
     std::iota(order.begin(), order.end(), 0);
@@ -259,7 +262,7 @@ class Recognizer::Impl {
       const bool first = model->instances.empty();
       const int views =
           first || options_.later_instance_views == 0 ? options_.views_per_model : options_.later_instance_views;
-      std::optional<Verified> best =
+      std::optional<VerifiedPose> best =
           search.BestPose(views, first ? options_.give_up_after_views : 0, model->covered, &ranked, &result.times);
       if (best && options_.twins.enabled) best = BestTwin(m, scene, std::move(*best), &result.times);
       if (!best || !Accepted(best->detection)) break;
@@ -273,13 +276,13 @@ class Recognizer::Impl {
   // `hypothesis` refined by ICP from `verified` (its verification) and verified again; both are replaced when that
   // does not lower the score. Adds ICP and verification times.
   void RefineIfBetter(size_t model, const Scene& scene, const ModelSearch& search, Hypothesis* hypothesis,
-                      Verified* verified, StageTimes* times) {
+                      VerifiedPose* verified, StageTimes* times) {
     Hypothesis refined_hypothesis = *hypothesis;
     Clock::time_point stage = Clock::now();
     search.Refine(verified->depth, &refined_hypothesis);
     times->Add(Stage::kRefine, MillisecondsSince(stage));
     stage = Clock::now();
-    Verified refined = Verify(model, scene, refined_hypothesis);
+    VerifiedPose refined = Verify(model, scene, refined_hypothesis);
     times->Add(Stage::kVerify, MillisecondsSince(stage));
     if (refined.detection.score >= verified->detection.score) {
       *hypothesis = refined_hypothesis;
@@ -296,8 +299,8 @@ class Recognizer::Impl {
 
   // `pose`, or the best of its turns by 180 degrees about the model's principal axes (each refined by ICP when it
   // scored rival_min_ratio of `pose`) that beats it (TwinOptions). Adds verification and ICP times.
-  Verified BestTwin(size_t model, const Scene& scene, Verified pose, StageTimes* times) {
-    const PrincipalBox& principal = axes_[model];
+  VerifiedPose BestTwin(size_t model, const Scene& scene, VerifiedPose pose, StageTimes* times) {
+    const PrincipalBox& principal = models_[model].axes;
     const Detection original = pose.detection;
     const ModelSearch search = Search(model, scene, 1);
     for (int axis = 0; axis < 3; ++axis) {
@@ -307,7 +310,7 @@ class Recognizer::Impl {
       hypothesis.ransac.fit_error_m = original.fit_error_m;
       hypothesis.pose = TurnedHalfWayAbout(original.camera_from_object, principal.centre, principal.axes.col(axis));
       const Clock::time_point stage = Clock::now();
-      Verified turned = Verify(model, scene, hypothesis);
+      VerifiedPose turned = Verify(model, scene, hypothesis);
       times->Add(Stage::kVerify, MillisecondsSince(stage));
       if (options_.refine && turned.search_score > 0.0 &&
           turned.search_score >= options_.rival_min_ratio * pose.search_score) {
@@ -315,7 +318,7 @@ class Recognizer::Impl {
       }
       if (turned.detection.score > options_.twins.min_gain * pose.detection.score &&
           FitsAsWell(turned.detection, pose.detection)) {
-        turned.detection.hypothesis = original.hypothesis;
+        turned.detection.hypothesis_source = original.hypothesis_source;
         pose = std::move(turned);
       }
     }
@@ -324,24 +327,24 @@ class Recognizer::Impl {
 
   // A prior's model at the prior's pose refined by ICP (from the model's surface rendered there) and verified. The
   // prior's own pose is verified only when the refined one is not accepted, and the better kept (RANSAC fields 0).
-  Verified Track(size_t model, const Detection& prior, const Scene& scene) {
+  VerifiedPose Track(size_t model, const Detection& prior, const Scene& scene) {
     Hypothesis hypothesis;
     hypothesis.view = prior.view;
     hypothesis.pose = prior.camera_from_object;
-    std::optional<Verified> best;
+    std::optional<VerifiedPose> best;
     if (options_.refine) {
       Hypothesis refined = hypothesis;
       Search(model, scene, 1).Refine(Render(model, scene, hypothesis.pose).depth, &refined);
       best = Verify(model, scene, refined);
     }
     if (!best || !Accepted(best->detection)) {
-      Verified at_prior = Verify(model, scene, hypothesis);
+      VerifiedPose at_prior = Verify(model, scene, hypothesis);
       if (!best || at_prior.detection.score > best->detection.score) best = std::move(at_prior);
     }
     best->detection.tracked = true;
     best->detection.frames_followed = prior.frames_followed + 1;
     best->detection.confirmed = prior.confirmed;
-    best->detection.hypothesis = prior.hypothesis;
+    best->detection.hypothesis_source = prior.hypothesis_source;
     return std::move(*best);
   }
 
@@ -377,7 +380,7 @@ class Recognizer::Impl {
   void SearchByPointPairs(const Scene& scene, std::vector<ModelInFrame>* models, StageTimes* times) {
     std::vector<size_t> wanted;
     for (size_t m = 0; m < models->size(); ++m) {
-      if ((*models)[m].search && (*models)[m].instances.empty() && ppf_models_[m]) wanted.push_back(m);
+      if ((*models)[m].search && (*models)[m].instances.empty() && models_[m].point_pairs) wanted.push_back(m);
     }
     if (wanted.empty()) return;
     const std::vector<OrientedPoint> points =
@@ -385,8 +388,8 @@ class Recognizer::Impl {
             ? WithoutDominantPlane(OrientedScenePoints(scene.organized), options_.point_pairs.plane)
             : OrientedScenePoints(scene.organized);
     std::vector<StageTimes> model_times(wanted.size());
-    ParallelFor(wanted.size(), options_.ransac.threads, [&](size_t i) {
-      std::optional<Verified> best = BestPointPairPose(wanted[i], scene, points, &model_times[i]);
+    ParallelFor(wanted.size(), options_.threads, [&](size_t i) {
+      std::optional<VerifiedPose> best = BestPointPairPose(wanted[i], scene, points, &model_times[i]);
       if (best && options_.twins.enabled) best = BestTwin(wanted[i], scene, std::move(*best), &model_times[i]);
       if (best && Accepted(best->detection)) {
         AddInstance(std::move(*best), options_.dense_stride_px, scene.frame->depth.size(), &(*models)[wanted[i]]);
@@ -397,21 +400,21 @@ class Recognizer::Impl {
 
   // The model's best point pair pose clusters among the scene's oriented `points`, each verified, refined by ICP and
   // verified again (the better kept); the best of them.
-  std::optional<Verified> BestPointPairPose(size_t model, const Scene& scene, const std::vector<OrientedPoint>& points,
-                                            StageTimes* times) {
+  std::optional<VerifiedPose> BestPointPairPose(size_t model, const Scene& scene,
+                                                const std::vector<OrientedPoint>& points, StageTimes* times) {
     Clock::time_point stage = Clock::now();
-    const std::vector<PpfPose> poses = FindPpfPoses(*ppf_models_[model], points);
+    const std::vector<PpfPose> poses = FindPpfPoses(*models_[model].point_pairs, points);
     times->Add(Stage::kPointPairs, MillisecondsSince(stage));
     const ModelSearch search = Search(model, scene, 1);
-    std::optional<Verified> best;
+    std::optional<VerifiedPose> best;
     for (size_t c = 0; c < poses.size() && c < static_cast<size_t>(options_.point_pairs.clusters); ++c) {
       Hypothesis hypothesis;
       hypothesis.pose = poses[c].camera_from_object;
       stage = Clock::now();
-      Verified verified = Verify(model, scene, hypothesis);
+      VerifiedPose verified = Verify(model, scene, hypothesis);
       times->Add(Stage::kVerify, MillisecondsSince(stage));
       if (options_.refine) RefineIfBetter(model, scene, search, &hypothesis, &verified, times);
-      verified.detection.hypothesis = HypothesisSource::kPpf;
+      verified.detection.hypothesis_source = HypothesisSource::kPpf;
       if (!best || verified.detection.score > best->detection.score) best = std::move(verified);
     }
     return best;
@@ -419,12 +422,13 @@ class Recognizer::Impl {
 
   // The detections, best first, without those whose rendered surface lies mostly (max_overlap) on scene pixels
   // that a better detection of another model already explains: one surface, one object.
-  std::vector<Detection> SuppressOverlaps(const cv::Size& image_size, std::vector<Verified> candidates) const {
-    std::stable_sort(candidates.begin(), candidates.end(),
-                     [](const Verified& a, const Verified& b) { return a.detection.score > b.detection.score; });
+  std::vector<Detection> SuppressOverlaps(const cv::Size& image_size, std::vector<VerifiedPose> candidates) const {
+    std::stable_sort(candidates.begin(), candidates.end(), [](const VerifiedPose& a, const VerifiedPose& b) {
+      return a.detection.score > b.detection.score;
+    });
     cv::Mat explained = cv::Mat::zeros(image_size, CV_8UC1);
     std::vector<Detection> kept;
-    for (const Verified& candidate : candidates) {
+    for (const VerifiedPose& candidate : candidates) {
       const std::vector<cv::Point>& surface = candidate.surface;
       const auto taken = std::count_if(surface.begin(), surface.end(),
                                        [&](const cv::Point& p) { return explained.at<uchar>(p) != 0; });
@@ -441,11 +445,11 @@ class Recognizer::Impl {
   RenderResult Render(size_t model, const Scene& scene, const Eigen::Isometry3d& pose) {
     const PinholeCamera camera = scene.frame->camera.Sampled(options_.dense_stride_px);
     const std::lock_guard<std::mutex> lock(render_mutex_);
-    return renderer_.Render(meshes_[model], camera, pose, render_options_[model]);
+    return renderer_.Render(models_[model].mesh, camera, pose, models_[model].render);
   }
 
   // The model rendered at the pose, measured against the frame and scored.
-  Verified Verify(size_t model, const Scene& scene, const Hypothesis& hypothesis) {
+  VerifiedPose Verify(size_t model, const Scene& scene, const Hypothesis& hypothesis) {
     const LibraryModel& library_model = library_.models()[model];
     const RenderResult rendered = Render(model, scene, hypothesis.pose);
     Eigen::Matrix3f to_scene = Eigen::Matrix3f::Identity();
@@ -454,9 +458,9 @@ class Recognizer::Impl {
     }
     PoseEvidence evidence =
         MeasurePose({rendered.color, rendered.depth}, scene.verification, to_scene, options_.verify);
-    Verified verified;
+    VerifiedPose verified;
     Detection& detection = verified.detection;
-    ScorePose(evidence, options_.verify, plain_[model] != 0, &detection);
+    ScorePose(evidence, options_.verify, models_[model].plain, &detection);
     detection.model = library_model.record.name;
     detection.camera_from_object = hypothesis.pose;
     detection.inlier_fraction = hypothesis.ransac.inlier_fraction;
@@ -465,7 +469,7 @@ class Recognizer::Impl {
     VerifyOptions search = options_.verify;  // the search's score: without the continuation factor
     search.continuation_falloff = 0.0;
     Detection unjudged;
-    ScorePose(evidence, search, plain_[model] != 0, &unjudged);
+    ScorePose(evidence, search, models_[model].plain, &unjudged);
     verified.search_score = unjudged.score;
     if (options_.verify.reject_plane_patches && verified.search_score > 0.0 &&
         OnLargerPlane(*scene.frame, rendered.depth, evidence.surface, options_.dense_stride_px,
@@ -506,16 +510,10 @@ class Recognizer::Impl {
 
   const ModelLibrary& library_;
   RecognizerOptions options_;
-  std::vector<ModelRecord> records_;  // per model: the library's, colours mapped by its colour matrix if any
-  std::vector<std::string> model_names_;
   Renderer renderer_;
-  std::mutex render_mutex_;  // Verify runs on the model workers
-  std::vector<MeshId> meshes_;
-  std::vector<RenderOptions> render_options_;        // per model: shaded as its library views are
-  std::vector<std::optional<PpfModel>> ppf_models_;  // per model, with point pair hypotheses: its table, if any
-  std::vector<std::string> ppf_refusals_;            // per model without a table: why
-  std::vector<char> plain_;         // per model: painted in material colours alone (VerifyOptions::plain_appearance)
-  std::vector<PrincipalBox> axes_;  // per model: about which its poses are turned (TwinOptions)
+  std::mutex render_mutex_;               // Verify runs on the model workers
+  std::vector<LoadedModel> models_;       // in the library's order
+  std::vector<std::string> model_names_;  // the same order
 };
 
 cv::Mat Recognizer::Impl::DrawDetections(const RgbdFrame& frame, const std::vector<Detection>& detections) {
@@ -524,7 +522,7 @@ cv::Mat Recognizer::Impl::DrawDetections(const RgbdFrame& frame, const std::vect
   for (const Detection& detection : detections) {
     const auto name = std::find(model_names_.begin(), model_names_.end(), detection.model);
     if (name != model_names_.end()) {
-      objects.push_back({meshes_[static_cast<size_t>(name - model_names_.begin())], detection.camera_from_object});
+      objects.push_back({models_[static_cast<size_t>(name - model_names_.begin())].mesh, detection.camera_from_object});
       drawn.push_back(detection);
     }
   }

@@ -1,6 +1,7 @@
 #include "recognize/recognizer_options.h"
 
 #include "core/error.h"
+#include "core/parallel.h"
 
 namespace ecv {
 
@@ -65,6 +66,7 @@ void RecognizerOptions::Check() const {
   auto require = [](bool ok, const char* field, const char* expected) {
     if (!ok) ThrowInputError("recognizer options", field, expected);
   };
+  require(threads >= 1 && threads <= kMaxThreads, "threads", "1 to 256");
   require(ranking.max_correspondences >= 3, "ranking.max_correspondences", "at least 3");
   require(ranking.checks >= 0, "ranking.checks", "0 (match.checks) or more");
   require(preselect.models >= 0, "preselect.models", ">= 0 (0: search every model)");

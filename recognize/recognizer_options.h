@@ -45,6 +45,21 @@ struct TrackingOptions {
   int confirm_first = 1;
 };
 
+/// What a tracking frame (Recognizer::Recognize with priors) searches for, by view ranking and RANSAC, besides
+/// following its priors.
+enum class SearchScope {
+  kAllModels,  ///< every model whose prior fails or that has none: a full detection frame
+  /// Only the models whose prior failed or fell below TrackingOptions::min_follow_score (a lost track is looked for at
+  /// once) or whose track is due for confirmation (TrackingOptions::confirm_every); models without a prior are not
+  /// looked for. When every prior passes and none is due, the frame's primitives are not even
+  /// extracted. RecognitionStream alternates it with full frames to follow known objects at a fraction of the cost
+  /// and still pick up new ones every N frames.
+  kLostTracks,
+  /// No model is searched, not even for confirmation: the priors are followed, nothing else (RecognitionStream's
+  /// tracking when the search runs beside it, StreamOptions::search_beside).
+  kPriorsOnly,
+};
+
 /// Where pose hypotheses come from: the shape and appearance context descriptors (view ranking and RANSAC), point
 /// pair features of the model's surface (shape alone), or both, point pairs for the models the context did not find.
 enum class HypothesisSource { kContext, kPpf, kBoth };
@@ -92,9 +107,11 @@ struct TwinOptions {
 /// "Recognizer defaults", gives the measurements behind each default.
 struct RecognizerOptions {
   MatchOptions match = DefaultMatch();
+  /// The Recognizer's workers: they describe the scene and then take a model each (a model's RANSAC shares the spare
+  /// ones); the detections do not depend on the count.
+  int threads = 1;
   /// RANSAC per model view: the paper's test (t_poly 0.25, eps 1 cm, 50 % of the visible object points). Its
-  /// `threads` are the Recognizer's workers: they describe the scene and then take a model each; the detections
-  /// do not depend on the count.
+  /// `threads` are set per search from `threads`.
   RansacOptions ransac = DefaultRansac();
   RankingOptions ranking;
   PreselectOptions preselect;

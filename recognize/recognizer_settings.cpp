@@ -15,12 +15,11 @@
 namespace ecv {
 namespace {
 
-using S = RecognizerSettings;
 constexpr double kNoMax = std::numeric_limits<double>::infinity();
 
 // The type of the field that `field` (a lambda taking the settings) leads to.
 template <typename Field>
-using FieldType = std::remove_reference_t<decltype(std::declval<Field>()(std::declval<S&>()))>;
+using FieldType = std::remove_reference_t<decltype(std::declval<Field>()(std::declval<RecognizerSettings&>()))>;
 
 // A row without its range and accessors.
 Setting Row(const char* name, SettingType type, const char* help) {
@@ -37,8 +36,8 @@ Setting Count(const char* name, double min, double max, const char* help, Field 
   Setting setting = Row(name, SettingType::kCount, help);
   setting.min = min;
   setting.max = max;
-  setting.get = [field](const S& s) -> SettingValue { return static_cast<int64_t>(field(s)); };
-  setting.put = [field](const SettingValue& value, S* s) {
+  setting.get = [field](const RecognizerSettings& s) -> SettingValue { return static_cast<int64_t>(field(s)); };
+  setting.put = [field](const SettingValue& value, RecognizerSettings* s) {
     field(*s) = static_cast<FieldType<Field>>(std::get<int64_t>(value));
   };
   return setting;
@@ -50,8 +49,8 @@ Setting Number(const char* name, double min, double max, const char* help, Field
   Setting setting = Row(name, SettingType::kNumber, help);
   setting.min = min;
   setting.max = max;
-  setting.get = [field](const S& s) -> SettingValue { return static_cast<double>(field(s)); };
-  setting.put = [field](const SettingValue& value, S* s) { field(*s) = std::get<double>(value); };
+  setting.get = [field](const RecognizerSettings& s) -> SettingValue { return static_cast<double>(field(s)); };
+  setting.put = [field](const SettingValue& value, RecognizerSettings* s) { field(*s) = std::get<double>(value); };
   return setting;
 }
 
@@ -61,8 +60,8 @@ template <typename Get, typename Put>
 Setting FlagOf(const char* name, bool negated, const char* help, Get get, Put put) {
   Setting setting = Row(name, SettingType::kFlag, help);
   setting.negated = negated;
-  setting.get = [get](const S& s) -> SettingValue { return static_cast<bool>(get(s)); };
-  setting.put = [put](const SettingValue& value, S* s) { put(*s, std::get<bool>(value)); };
+  setting.get = [get](const RecognizerSettings& s) -> SettingValue { return static_cast<bool>(get(s)); };
+  setting.put = [put](const SettingValue& value, RecognizerSettings* s) { put(*s, std::get<bool>(value)); };
   return setting;
 }
 
@@ -70,7 +69,8 @@ Setting FlagOf(const char* name, bool negated, const char* help, Get get, Put pu
 template <typename Field>
 Setting Flag(const char* name, bool negated, const char* help, Field field) {
   return FlagOf(
-      name, negated, help, [field](const S& s) { return field(s); }, [field](S& s, bool on) { field(s) = on; });
+      name, negated, help, [field](const RecognizerSettings& s) { return field(s); },
+      [field](RecognizerSettings& s, bool on) { field(s) = on; });
 }
 
 // A setting taking one of `choices`, read by `get` and written by `put` (both with the choice's name).
@@ -78,8 +78,8 @@ template <typename Get, typename Put>
 Setting Choice(const char* name, std::vector<std::string> choices, const char* help, Get get, Put put) {
   Setting setting = Row(name, SettingType::kChoice, help);
   setting.choices = std::move(choices);
-  setting.get = [get](const S& s) -> SettingValue { return std::string(get(s)); };
-  setting.put = [put](const SettingValue& value, S* s) { put(*s, std::get<std::string>(value)); };
+  setting.get = [get](const RecognizerSettings& s) -> SettingValue { return std::string(get(s)); };
+  setting.put = [put](const SettingValue& value, RecognizerSettings* s) { put(*s, std::get<std::string>(value)); };
   return setting;
 }
 
@@ -140,14 +140,16 @@ void AddSearchSettings(std::vector<Setting>* table) {
       "Where poses come from: context (shape and appearance context descriptors, view ranking and RANSAC),\n"
       "ppf (point pair features of the model's surface: shape alone) or both (point pairs for the models the\n"
       "context does not find: objects that show a plain side)",
-      [](const S& s) { return HypothesisSourceName(s.options.point_pairs.source); },
-      [](S& s, const std::string& name) { s.options.point_pairs.source = ParseHypothesisSource(name, "hypotheses"); }));
+      [](const RecognizerSettings& s) { return HypothesisSourceName(s.options.point_pairs.source); },
+      [](RecognizerSettings& s, const std::string& name) {
+        s.options.point_pairs.source = ParseHypothesisSource(name, "hypotheses");
+      }));
   table->push_back(Count(
       "seed", 0, kNoMax, "Random seed", [](auto& s) -> auto& { return s.options.ransac.seed; }));
   table->push_back(Count(
       "threads", 1, kMaxThreads,
       "Worker threads for describing the scene and searching the models, one model each (same result for any count)",
-      [](auto& s) -> auto& { return s.options.ransac.threads; }));
+      [](auto& s) -> auto& { return s.options.threads; }));
   table->push_back(Flag(
       "icp", true, "Skip the ICP refinement", [](auto& s) -> auto& { return s.options.refine; }));
 }
@@ -196,8 +198,10 @@ void AddVerifySettings(std::vector<Setting>* table) {
       "contour", true,
       "Verify without the contour factor (a pose's outline on the scene's depth steps): for flat objects thinner\n"
       "than 1 cm lying on a surface, or parts packed flush in a tray",
-      [](const S& s) { return s.options.verify.contour_falloff > 0.0; },
-      [](S& s, bool on) { s.options.verify.contour_falloff = on ? VerifyOptions().contour_falloff : 0.0; }));
+      [](const RecognizerSettings& s) { return s.options.verify.contour_falloff > 0.0; },
+      [](RecognizerSettings& s, bool on) {
+        s.options.verify.contour_falloff = on ? VerifyOptions().contour_falloff : 0.0;
+      }));
   table->push_back(Number(
       "continuation-free", 0, 1,
       "The continuation factor is 1 up to this share of a pose's outline across which the scene's surface\n"
@@ -208,8 +212,10 @@ void AddVerifySettings(std::vector<Setting>* table) {
       "continuation", true,
       "Verify without the continuation factor (the scene's surface running on across a pose's outline):\n"
       "for objects packed flush against each other or sunk into a surface",
-      [](const S& s) { return s.options.verify.continuation_falloff > 0.0; },
-      [](S& s, bool on) { s.options.verify.continuation_falloff = on ? VerifyOptions().continuation_falloff : 0.0; }));
+      [](const RecognizerSettings& s) { return s.options.verify.continuation_falloff > 0.0; },
+      [](RecognizerSettings& s, bool on) {
+        s.options.verify.continuation_falloff = on ? VerifyOptions().continuation_falloff : 0.0;
+      }));
   table->push_back(Number(
       "plain-appearance", 0, 1,
       "The appearance term of a model without texture or vertex colours (a grey CAD mesh), judged by its\n"
@@ -223,15 +229,15 @@ void AddVerifySettings(std::vector<Setting>* table) {
       "nearest-inliers", false,
       "RANSAC finds an object point's inlier partner by a search among the scene's points in 3D (the paper)\n"
       "instead of among the depth samples around where the point is seen",
-      [](const S& s) { return !s.options.projective_inliers; },
-      [](S& s, bool nearest) { s.options.projective_inliers = !nearest; }));
+      [](const RecognizerSettings& s) { return !s.options.projective_inliers; },
+      [](RecognizerSettings& s, bool nearest) { s.options.projective_inliers = !nearest; }));
   table->push_back(Choice(
       "matcher", {"kd-forest", "bytes"},
       "kd-forest (FLANN's randomised kd-trees, approximate: the same matches on every CPU) or bytes\n"
       "(every scene descriptor compared over 7-bit values: nearer neighbours, 2x faster where the CPU\n"
       "has AVX-512 VNNI, 20x slower where it has not)",
-      [](const S& s) { return s.options.match.index == MatchIndex::kBytes ? "bytes" : "kd-forest"; },
-      [](S& s, const std::string& name) {
+      [](const RecognizerSettings& s) { return s.options.match.index == MatchIndex::kBytes ? "bytes" : "kd-forest"; },
+      [](RecognizerSettings& s, const std::string& name) {
         s.options.match.index = name == "bytes" ? MatchIndex::kBytes : MatchIndex::kKdForest;
       }));
   table->push_back(Flag(
@@ -286,8 +292,8 @@ void AddFurtherSettings(std::vector<Setting>* table) {
   table->push_back(FlagOf(
       "ppf-keep-plane", false,
       "With --hypotheses ppf or both: the scene's dominant plane (a table top) votes too (default: left out)",
-      [](const S& s) { return !s.options.point_pairs.remove_plane; },
-      [](S& s, bool keep) { s.options.point_pairs.remove_plane = !keep; }));
+      [](const RecognizerSettings& s) { return !s.options.point_pairs.remove_plane; },
+      [](RecognizerSettings& s, bool keep) { s.options.point_pairs.remove_plane = !keep; }));
 }
 
 std::vector<Setting> MakeTable() {

@@ -1,7 +1,6 @@
 #include "recognize/scene.h"
 
 #include "core/timing.h"
-#include "recognize/recognizer.h"
 
 namespace ecv {
 
@@ -74,7 +73,7 @@ Descriptors ComputeSceneDescriptors(const std::vector<Primitive>& primitives, co
   }
   const size_t count = primitives.size(), most = static_cast<size_t>(options.scene_max_descriptors);
   const int source_step = most > 0 && count > most ? static_cast<int>((count + most - 1) / most) : 1;
-  return ComputeDescriptors(primitives, describe, options.ransac.threads, source_step, surface);
+  return ComputeDescriptors(primitives, describe, options.threads, source_step, surface);
 }
 
 }  // namespace ecv

@@ -1,6 +1,7 @@
 #pragma once
 
-// What one frame offers to every model's search, and where a frame's time goes. Internal to the recognizer.
+// What one frame offers to every model's search, and where a frame's time goes. Internal to the recognizer, but for
+// ComputeSceneDescriptors, which benches and tests call to describe a scene as the recognizer does.
 
 #include <array>
 #include <map>
@@ -77,5 +78,12 @@ Scene PrepareScene(const RgbdFrame& frame, const RecognizerOptions& options);
 /// The frame's primitives, their descriptors under the library's `settings` and a matcher over them: what view
 /// ranking and RANSAC need.
 void DescribeScene(const FeatureSettings& settings, const RecognizerOptions& options, Scene* scene, StageTimes* times);
+
+/// A frame's descriptors as the recognizer computes them from its `primitives`: the library's `descriptor`
+/// settings with at most options.scene_max_neighbours neighbours per context, and every n-th primitive a source
+/// so that at most options.scene_max_descriptors are described; on options.threads threads. `surface`: the
+/// frame's surface, for a library whose descriptors use the surface context (DescriptorShape::kSurface).
+Descriptors ComputeSceneDescriptors(const std::vector<Primitive>& primitives, const DescriptorOptions& descriptor,
+                                    const RecognizerOptions& options, const SurfaceSamples* surface = nullptr);
 
 }  // namespace ecv

@@ -17,7 +17,7 @@ struct ConsistencyOptions {
   /// is within RANSAC's 1 cm, so a true pair's distances differ by up to 2 cm), metres ...
   double tolerance_m = 0.015;
   /// ... and the |cosines| between their orientations, and between each orientation and the line joining
-  /// them, agree within this (tighter values found fewer objects).
+  /// them, differ by at most this (unitless, as |cosines| lie in [0, 1]); tighter rejects true pairs as well.
   double angle_tolerance = 0.4;
   double min_distance_m = 0.02;  ///< pairs closer than this say little and are not counted, metres
   double max_distance_m = 1.0;   ///< nor pairs further apart than this (the recognizer: the model diameter)
@@ -37,7 +37,7 @@ int ConsistentSetSize(const std::vector<Primitive>& object, const std::vector<Pr
 /// When a pose only explains a patch of a larger plane (see PatchOfLargerPlane).
 struct PlanePatchOptions {
   double distance_m = 0.01;  ///< a point lies on the surface points' plane (least squares) within this, metres
-  double min_share = 0.8;    ///< the surface is planar, and the ring on its plane, when this share of them is
+  double min_share = 0.8;    ///< the surface is planar, and the ring on its plane, when this share of each lies on it
   int min_points = 20;       ///< fewer surface or ring points decide nothing (false)
 
   /// Throws InputError on values outside their ranges.

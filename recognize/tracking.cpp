@@ -4,7 +4,7 @@
 
 namespace ecv {
 
-void AddInstance(Verified verified, int stride, const cv::Size& image_size, ModelInFrame* model) {
+void AddInstance(VerifiedPose verified, int stride, const cv::Size& image_size, ModelInFrame* model) {
   if (model->covered.empty()) model->covered = cv::Mat::zeros(image_size, CV_8UC1);
   CoverSurface(verified.surface, stride, &model->covered);
   model->instances.push_back(std::move(verified));
@@ -34,7 +34,7 @@ int ChooseModels(SearchScope scope, const TrackingOptions& tracking, int max_ins
   for (ModelInFrame& model : *models) {
     const bool due =
         scope != SearchScope::kPriorsOnly && confirm_every > 0 &&
-        std::any_of(model.instances.begin(), model.instances.end(), [&](const Verified& instance) {
+        std::any_of(model.instances.begin(), model.instances.end(), [&](const VerifiedPose& instance) {
           return instance.detection.frames_followed >= (instance.detection.confirmed ? confirm_every : confirm_first);
         });
     if (due) {
@@ -81,8 +81,8 @@ void MergeConfirmation(const cv::Size& image_size, double max_overlap, int max_i
                        ModelInFrame* model) {
   if (model->to_confirm.empty()) return;
   std::vector<Followed> candidates;  // the tracks, then the search's instances (from_search)
-  for (Verified& track : model->to_confirm) candidates.push_back({std::move(track), false});
-  for (Verified& searched : model->instances) candidates.push_back({std::move(searched), true});
+  for (VerifiedPose& track : model->to_confirm) candidates.push_back({std::move(track), false});
+  for (VerifiedPose& searched : model->instances) candidates.push_back({std::move(searched), true});
   model->to_confirm.clear();
   model->instances.clear();
   model->covered = cv::Mat();

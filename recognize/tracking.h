@@ -9,8 +9,9 @@
 
 #include <opencv2/core.hpp>
 
+#include "recognize/detection.h"
 #include "recognize/model_search.h"
-#include "recognize/recognizer.h"
+#include "recognize/recognizer_options.h"
 
 namespace ecv {
 
@@ -18,16 +19,16 @@ namespace ecv {
 /// pixels their surfaces cover, and whether it is still to be searched by view ranking and RANSAC.
 struct ModelInFrame {
   std::vector<const Detection*> priors;
-  std::vector<Verified> instances;
+  std::vector<VerifiedPose> instances;
   cv::Mat covered;    ///< CV_8UC1 of the frame's size once an instance is added: its surfaces (CoverSurface)
   bool lost = false;  ///< seen before: a prior failed or scored too low to follow
   bool search = false;
   /// Tracked instances due for confirmation, set aside while their model is searched as if it had no priors.
-  std::vector<Verified> to_confirm;
+  std::vector<VerifiedPose> to_confirm;
 };
 
 /// Adds `verified` to `model`'s instances and its surface (sampled every `stride` pixels) to the covered pixels.
-void AddInstance(Verified verified, int stride, const cv::Size& image_size, ModelInFrame* model);
+void AddInstance(VerifiedPose verified, int stride, const cv::Size& image_size, ModelInFrame* model);
 
 /// Each model's priors to follow (models in the order of `model_names`), in their order. A prior below
 /// tracking.min_follow_score is not followed but makes its model `lost`: it was seen, so even a frame that searches
@@ -38,7 +39,7 @@ std::vector<ModelInFrame> AssignPriors(const std::vector<Detection>& priors,
 /// An instance followed from a prior (Recognizer's Track), and whether that prior was a search's detection rather than
 /// a track: one followed from the previous frame's search, or from a search that ran beside the tracking.
 struct Followed {
-  Verified verified;
+  VerifiedPose verified;
   bool from_search = false;
 };
 

@@ -7,7 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
-#include "recognize/recognizer.h"
+#include "recognize/detection.h"
 
 namespace ecv {
 

@@ -128,7 +128,7 @@ py::dict SettingsDict(const RecognizerSettings& settings) {
 // help(ecvpose.Recognizer): the keywords with their defaults and help, from the table.
 std::string RecognizerDoc() {
   RecognizerSettings defaults;
-  defaults.options.ransac.threads = kPythonThreads;
+  defaults.options.threads = kPythonThreads;
   std::ostringstream doc;
   doc << kRecognizerDoc
       << "\n\nKeywords (the flags of `ecvpose recognize` with underscores; default, then what it "
@@ -227,7 +227,7 @@ void BindDetection(py::module_& m) {
       .def_readonly("tracked", &Detection::tracked)
       .def_readonly("frames_followed", &Detection::frames_followed)
       .def_readonly("confirmed", &Detection::confirmed)
-      .def_property_readonly("hypothesis", [](const Detection& d) { return HypothesisSourceName(d.hypothesis); })
+      .def_property_readonly("hypothesis", [](const Detection& d) { return HypothesisSourceName(d.hypothesis_source); })
       .def("__repr__", [](const Detection& d) {
         const Eigen::Vector3d t = d.camera_from_object.translation();
         return "<ecvpose.Detection " + d.model + " score " + std::to_string(d.score) + " at (" + std::to_string(t.x()) +
@@ -278,7 +278,7 @@ void BindRecognizer(py::module_& m) {
   py::class_<StreamRecognizer>(m, "Recognizer", "Finds a library's models in RGB-D frames.")
       .def(py::init([](std::shared_ptr<Library> library, const py::kwargs& options) {
              RecognizerSettings settings;
-             settings.options.ransac.threads = kPythonThreads;
+             settings.options.threads = kPythonThreads;
              for (const auto& [key, value] : options) SetKeyword(key.cast<std::string>(), value, &settings);
              return MakeRecognizer(std::move(library), settings);
            }),

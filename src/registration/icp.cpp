@@ -119,9 +119,8 @@ IcpResult RefinePointToPlane(const std::vector<Eigen::Vector3f>& object_points,
   if (object_points.empty() || scene_points.size() < static_cast<size_t>(options.normal_neighbours)) return result;
   const PointIndex tree(scene_points);
   const std::vector<Eigen::Vector3f> normals = EstimateNormals(scene_points, tree, options.normal_neighbours);
-  // Pairs lie within max_correspondence_m, so the nearest scene point within that radius is the nearest one:
-  // a grid finds it faster than the kd-tree, with the same pairs (the recognizer's refinement on the 30
-  // YCB-Video frames: 250 -> 130 ms per frame, median).
+  // Pairs lie within max_correspondence_m (metres), so the nearest scene point within that radius is the nearest
+  // one: a RadiusGrid finds it with fewer distance tests than the kd-tree, and gives the same pairs.
   const RadiusGrid grid(scene_points, static_cast<float>(options.max_correspondence_m));
 
   Iterate(object_points.size(), options, &result, [&](const Eigen::Isometry3f& transform, PointToPlaneSystem* system) {

@@ -15,7 +15,7 @@
   was built (--python-dir; skipped otherwise).
 
 Each failure names the file and the line. Usage:
-  docs_commands.py --ecvpose BUILD/src/app/ecvpose --source CHECKOUT [--python-dir BUILD/python] [--keep]
+  docs_commands.py --ecvpose BUILD/app/ecvpose --source CHECKOUT [--python-dir BUILD/python] [--keep]
 """
 
 import argparse

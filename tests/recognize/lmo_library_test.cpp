@@ -10,6 +10,7 @@
 #include "io/pose_io.h"
 #include "modeldb/model_library.h"
 #include "recognize/evaluation.h"
+#include "recognize/recognition_json.h"
 #include "support/test_data.h"
 
 namespace ecv {
@@ -86,7 +87,7 @@ TEST(LmoLibrary, FindsTheCanAndWithPointPairsTheDuckWithoutFalsePositives) {
   EXPECT_EQ(shaped_evaluation.false_positives, 0) << shaped.output;
   for (const Detection& detection : shaped_detections) {
     if (detection.model == "obj_000009") {
-      EXPECT_EQ(detection.hypothesis, HypothesisSource::kPpf);
+      EXPECT_EQ(detection.hypothesis_source, HypothesisSource::kPpf);
     }
   }
 }

@@ -82,13 +82,13 @@ TEST(StreamOptions, BesideTheTrackingTheSearchTakesTheSmallerHalfOfTheThreads) {
   RecognizerOptions options;
   for (const auto& [threads, track, search] :
        std::vector<std::tuple<int, int, int>>{{1, 1, 1}, {2, 1, 1}, {3, 2, 1}, {8, 4, 4}}) {
-    options.ransac.threads = threads;
+    options.threads = threads;
     stream.search_beside = false;
-    EXPECT_EQ(ShareThreads(options, stream).track.ransac.threads, threads);
+    EXPECT_EQ(ShareThreads(options, stream).track.threads, threads);
     stream.search_beside = true;
     const StreamRecognizerOptions shared = ShareThreads(options, stream);
-    EXPECT_EQ(shared.track.ransac.threads, track) << threads;
-    EXPECT_EQ(shared.search.ransac.threads, search) << threads;
+    EXPECT_EQ(shared.track.threads, track) << threads;
+    EXPECT_EQ(shared.search.threads, search) << threads;
   }
 }
 

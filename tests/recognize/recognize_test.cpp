@@ -20,6 +20,7 @@
 #include "modeldb/model_library.h"
 #include "modeldb/sql.h"
 #include "recognize/evaluation.h"
+#include "recognize/recognition_json.h"
 #include "recognize/recognizer.h"
 #include "support/demo_library.h"
 #include "support/test_data.h"
@@ -714,7 +715,7 @@ TEST_F(RecognizeEndToEnd, AMigratedLibraryKeepsItsRowsAndGetsThePointPairsOfAFre
 
   RecognizerOptions options;
   options.point_pairs.source = HypothesisSource::kPpf;
-  options.ransac.threads = 2;
+  options.threads = 2;
   const RgbdFrame frame = LoadYcbvFrame(Frame()).rgbd;
   LibraryLoadOptions load;
   load.build_matchers = false;
@@ -731,169 +732,6 @@ TEST_F(RecognizeEndToEnd, AMigratedLibraryKeepsItsRowsAndGetsThePointPairsOfAFre
     EXPECT_EQ(found[0][d].model, found[1][d].model);
     EXPECT_TRUE(found[0][d].camera_from_object.isApprox(found[1][d].camera_from_object, 1e-12)) << found[0][d].model;
   }
-}
-
-// A library built without its meshes reads them when a Recognizer is made (for verification renders), on worker
-// threads: a mesh file gone since the library was built is an error naming it, raised from whichever thread read it.
-TEST(RecognizeCli, AMeshFileGoneSinceALibraryWithoutMeshesWasBuiltIsNamed) {
-  const test::TemporaryDirectory directory;
-  const std::filesystem::path meshes = directory.File("meshes");
-  std::filesystem::copy(std::string(ECV_SOURCE_DIR) + "/models/meshes", meshes,
-                        std::filesystem::copy_options::recursive);
-  const std::string library = directory.File("library.sqlite");
-  const test::CommandResult build =
-      test::RunCli("modeldb build " + meshes.string() + " --views 4 --distance 0.9 --no-stored-mesh --db " + library);
-  ASSERT_EQ(build.exit_code, 0) << build.output;
-  EXPECT_NE(build.output.find("mesh not stored"), std::string::npos) << build.output;
-  const std::filesystem::path gone = meshes / "004_sugar_box" / "004_sugar_box.obj";
-  ASSERT_TRUE(std::filesystem::remove(gone));
-
-  const test::CommandResult run = test::RunCli("recognize --db " + library + " --threads 2 " +
-                                               std::string(ECV_SOURCE_DIR) + "/models/frame/000001");
-  EXPECT_NE(run.exit_code, 0) << run.output;
-  EXPECT_NE(run.output.find(gone.string()), std::string::npos) << run.output;
-}
-
-TEST(RecognizerOptions, OutOfRangeValuesAreReportedByName) {
-  EXPECT_NO_THROW(RecognizerOptions().Check());
-  auto message = [](const RecognizerOptions& options) {
-    try {
-      options.Check();
-    } catch (const InputError& error) {
-      return std::string(error.what());
-    }
-    return std::string("no error");
-  };
-  RecognizerOptions options;
-  options.ransac_stride_px = 0;
-  EXPECT_NE(message(options).find("ransac_stride_px"), std::string::npos) << message(options);
-  options = RecognizerOptions();
-  options.dense_stride_px = 0;
-  EXPECT_NE(message(options).find("dense_stride_px"), std::string::npos) << message(options);
-  options = RecognizerOptions();
-  options.scene_max_descriptors = -1;
-  EXPECT_NE(message(options).find("scene_max_descriptors"), std::string::npos) << message(options);
-  options = RecognizerOptions();
-  options.icp_max_points = -1;
-  EXPECT_NE(message(options).find("icp_max_points"), std::string::npos) << message(options);
-  options = RecognizerOptions();
-  options.verify.min_score = 1.5;
-  EXPECT_NE(message(options).find("min_score"), std::string::npos) << message(options);
-  options = RecognizerOptions();
-  options.verify.residual_falloff_m = -0.001;
-  EXPECT_NE(message(options).find("residual_falloff_m"), std::string::npos) << message(options);
-  options = RecognizerOptions();
-  options.max_instances = 0;
-  EXPECT_NE(message(options).find("max_instances"), std::string::npos) << message(options);
-  options = RecognizerOptions();
-  options.tracking.min_follow_score = -0.1;
-  EXPECT_NE(message(options).find("tracking.min_follow_score"), std::string::npos) << message(options);
-  options = RecognizerOptions();
-  options.tracking.confirm_every = -1;
-  EXPECT_NE(message(options).find("tracking.confirm_every"), std::string::npos) << message(options);
-  options = RecognizerOptions();
-  options.later_instance_views = -1;
-  EXPECT_NE(message(options).find("later_instance_views"), std::string::npos) << message(options);
-  options = RecognizerOptions();
-  options.verify.max_texture_size = 0;
-  EXPECT_NE(message(options).find("max_texture_size"), std::string::npos) << message(options);
-  options = RecognizerOptions();
-  options.good_enough_score = -0.1;
-  EXPECT_NE(message(options).find("good_enough_score"), std::string::npos) << message(options);
-  options = RecognizerOptions();
-  options.give_up_after_views = -1;
-  EXPECT_NE(message(options).find("give_up_after_views"), std::string::npos) << message(options);
-  options = RecognizerOptions();
-  options.give_up_below_score = -0.1;
-  EXPECT_NE(message(options).find("give_up_below_score"), std::string::npos) << message(options);
-  options = RecognizerOptions();
-  options.verify.edge_weight = 1.2;
-  EXPECT_NE(message(options).find("edge_weight"), std::string::npos) << message(options);
-  options = RecognizerOptions();
-  options.verify.min_edge_pixels = 0;
-  EXPECT_NE(message(options).find("min_edge_pixels"), std::string::npos) << message(options);
-  options = RecognizerOptions();
-  options.verify.edge.weak = -1.0;
-  EXPECT_NE(message(options).find("weak"), std::string::npos) << message(options);
-  options = RecognizerOptions();
-  options.rival_min_ratio = -0.5;
-  EXPECT_NE(message(options).find("rival_min_ratio"), std::string::npos) << message(options);
-  options = RecognizerOptions();
-  options.point_pairs.clusters = 0;
-  EXPECT_NE(message(options).find("point_pairs.clusters"), std::string::npos) << message(options);
-  options = RecognizerOptions();
-  options.point_pairs.ppf.spread_margin = 0.7;
-  EXPECT_NE(message(options).find("spread_margin"), std::string::npos) << message(options);
-}
-
-// Each detection's source of hypotheses survives the JSON; a source that is no detection's is refused by name.
-TEST(RecognitionJson, KeepsEachDetectionsHypothesisSource) {
-  RecognitionResult result;
-  result.detections.resize(2);
-  result.detections[0].model = "011_banana";
-  result.detections[0].hypothesis = HypothesisSource::kPpf;
-  result.detections[1].model = "006_mustard_bottle";
-  nlohmann::json json = RecognitionToJson(result);
-  EXPECT_EQ(json["detections"][0]["hypothesis"], "ppf");
-  EXPECT_EQ(json["detections"][1]["hypothesis"], "context");
-  const std::vector<Detection> read = DetectionsFromJson(json, "detections.json");
-  ASSERT_EQ(read.size(), 2U);
-  EXPECT_EQ(read[0].hypothesis, HypothesisSource::kPpf);
-  EXPECT_EQ(read[1].hypothesis, HypothesisSource::kContext);
-  // The message of DetectionsFromJson's refusal of `json` ("" when it reads it).
-  const auto refusal = [](const nlohmann::json& edited) {
-    try {
-      DetectionsFromJson(edited, "detections.json");
-    } catch (const InputError& error) {
-      return std::string(error.what());
-    }
-    return std::string();
-  };
-  json["detections"][0]["hypothesis"] = "both";
-  EXPECT_THAT(refusal(json), ::testing::HasSubstr("detections[0].hypothesis"));
-  json["detections"][0]["hypothesis"] = "ppf";
-  json["detections"][0]["score"] = "high";
-  EXPECT_THAT(refusal(json), ::testing::HasSubstr("detections[0].score"));
-  EXPECT_EQ(ParseHypothesisSource("both", "--hypotheses"), HypothesisSource::kBoth);
-  EXPECT_THROW(ParseHypothesisSource("shape", "--hypotheses"), InputError);
-}
-
-// The scene's descriptors (ComputeSceneDescriptors) keep the library's settings but for the two caps: every n-th
-// primitive a source beyond scene_max_descriptors, and no more neighbours than scene_max_neighbours unless the
-// library asks for fewer.
-TEST(SceneDescriptors, FollowTheRecognizersCaps) {
-  std::vector<Primitive> primitives;  // 1000 texlets 4 mm apart: most have over a hundred within 2.5 cm
-  for (int i = 0; i < 1000; ++i) {
-    Primitive texlet;
-    texlet.position = Eigen::Vector3f(0.004F * static_cast<float>(i % 40), 0.004F * static_cast<float>(i / 40), 1.0F);
-    texlet.color = Eigen::Vector3f(0.3F, 0.5F, static_cast<float>(i % 7) / 7.0F);
-    primitives.push_back(texlet);
-  }
-  DescriptorOptions library;
-  RecognizerOptions options;
-  options.ransac.threads = 1;
-  options.scene_max_descriptors = 300;  // 1000 primitives: every 4th is a source
-  options.scene_max_neighbours = 16;
-  const Descriptors capped = ComputeSceneDescriptors(primitives, library, options);
-  ASSERT_EQ(capped.values.rows, 250);
-  for (const int source : capped.primitive) EXPECT_EQ(source % 4, 0);
-  DescriptorOptions sixteen = library;
-  sixteen.max_neighbours = 16;
-  const Descriptors expected = ComputeDescriptors(primitives, sixteen, 1, 4);
-  EXPECT_EQ(cv::norm(capped.values, expected.values, cv::NORM_INF), 0.0);
-  EXPECT_GT(cv::norm(capped.values, ComputeDescriptors(primitives, library, 1, 4).values, cv::NORM_INF), 0.01);
-
-  DescriptorOptions eight = library;  // the library's own tighter cap stays
-  eight.max_neighbours = 8;
-  EXPECT_EQ(cv::norm(ComputeSceneDescriptors(primitives, eight, options).values,
-                     ComputeDescriptors(primitives, eight, 1, 4).values, cv::NORM_INF),
-            0.0);
-
-  options.scene_max_descriptors = 0;  // 0: every primitive; scene_max_neighbours 0: the library's setting
-  options.scene_max_neighbours = 0;
-  const Descriptors all = ComputeSceneDescriptors(primitives, library, options);
-  EXPECT_EQ(all.values.rows, 1000);
-  EXPECT_EQ(cv::norm(all.values, ComputeDescriptors(primitives, library).values, cv::NORM_INF), 0.0);
 }
 
 }  // namespace

@@ -11,7 +11,7 @@ The table is what `ecvpose recognize --settings-json` prints (recognize/recogniz
 - the tuning table of docs/how-it-works.md: each setting's flag and default.
 A flag of a front end that is no setting must be in that front end's list below (its files, frames and runs).
 
-Usage: recognizer_settings.py --ecvpose BUILD/src/app/ecvpose --source CHECKOUT [--bench BUILD/bench]
+Usage: recognizer_settings.py --ecvpose BUILD/app/ecvpose --source CHECKOUT [--bench BUILD/bench]
                               [--python-dir BUILD/python]
 """
 

@@ -20,8 +20,8 @@ Detection Prior(const std::string& model, double score, int frames_followed = 0)
 }
 
 // A verified instance whose surface is the rectangle's pixels.
-Verified Instance(double score, const cv::Rect& surface, bool tracked, int frames_followed = 0) {
-  Verified verified;
+VerifiedPose Instance(double score, const cv::Rect& surface, bool tracked, int frames_followed = 0) {
+  VerifiedPose verified;
   verified.detection = Prior("box", score, tracked ? frames_followed : 0);
   verified.detection.tracked = tracked;
   for (int v = surface.y; v < surface.y + surface.height; ++v) {
@@ -172,7 +172,7 @@ TEST(Tracking, AConfirmingSearchKeepsTheBetterPoseOfASurfaceAndConfirmsATrackItF
 }
 
 TEST(Tracking, SharedFractionIsTheShareOfTheFirstSurfaceTheOtherCovers) {
-  const Verified a = Instance(0.5, {0, 0, 10, 10}, false), b = Instance(0.5, {5, 0, 10, 10}, false);
+  const VerifiedPose a = Instance(0.5, {0, 0, 10, 10}, false), b = Instance(0.5, {5, 0, 10, 10}, false);
   EXPECT_DOUBLE_EQ(SharedFraction(a.surface, b.surface, kImage), 0.5);
   EXPECT_DOUBLE_EQ(SharedFraction(a.surface, a.surface, kImage), 1.0);
   EXPECT_DOUBLE_EQ(SharedFraction({}, a.surface, kImage), 0.0);

@@ -23,6 +23,7 @@
 #include "io/pose_io.h"
 #include "modeldb/model_library.h"
 #include "recognize/evaluation.h"
+#include "recognize/recognition_json.h"
 #include "recognize/recognition_stream.h"
 #include "recognize/recognizer.h"
 #include "scenes/composites.h"
@@ -423,7 +424,7 @@ TEST_F(YcbvLibrary, PointPairsFindTheBananaThatTheContextMisses) {
     ASSERT_EQ(by_model.count(object.model), 1U) << object.model;
     const HypothesisSource expected =
         object.model == "011_banana" ? HypothesisSource::kPpf : HypothesisSource::kContext;
-    EXPECT_EQ(by_model[object.model]->hypothesis, expected) << object.model;
+    EXPECT_EQ(by_model[object.model]->hypothesis_source, expected) << object.model;
     if (object.model == "011_banana") {  // within 1 cm and 5 degrees
       EXPECT_LT(object.error.translation_mm, 10.0);
       EXPECT_LT(object.error.rotation_deg, 5.0);
@@ -697,7 +698,7 @@ TEST_F(YcbvLibrary, TheCliTracksAsTheRecognitionStreamDoes) {
   load.build_matchers = false;
   const ModelLibrary library = ModelLibrary::Load(library_, load);
   RecognizerOptions options;
-  options.ransac.threads = 1;
+  options.threads = 1;
   Recognizer recognizer(library, options);
   RecognitionStream stream(recognizer, {true, 2});
   int tracked = 0;
@@ -733,10 +734,10 @@ TEST_F(YcbvLibrary, TheSearchBesideTheTrackingBringsItsObjectsIntoTheFramesAfter
   beside.track = true;
   beside.search_beside = true;
   RecognizerOptions options;
-  options.ransac.threads = 2;
+  options.threads = 2;
   const StreamRecognizerOptions shared = ShareThreads(options, beside);
-  EXPECT_EQ(shared.track.ransac.threads, 1);  // one thread tracks, one searches
-  EXPECT_EQ(shared.search.ransac.threads, 1);
+  EXPECT_EQ(shared.track.threads, 1);  // one thread tracks, one searches
+  EXPECT_EQ(shared.search.threads, 1);
   Recognizer tracker(library, shared.track);
   RecognitionStream stream(tracker, beside, MakeRecognizerFactory(library, shared.search));
 

@@ -1,4 +1,4 @@
-#include "recognize/sequence_io.h"
+#include "app/sequence_io.h"
 
 #include <errno.h>
 #include <fcntl.h>

@@ -1,4 +1,4 @@
-#include "camera/view/viewer.h"
+#include "app/view/viewer.h"
 
 #include <chrono>
 #include <cstdio>
@@ -11,7 +11,7 @@
 #include <opencv2/highgui.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include "camera/view/shown_frame.h"
+#include "app/view/shown_frame.h"
 
 namespace ecv::view {
 namespace {

@@ -6,7 +6,7 @@
 #include <csignal>
 #include <string>
 
-#include "camera/view/recognizer_child.h"
+#include "app/view/recognizer_child.h"
 
 namespace ecv::view {
 

@@ -5,7 +5,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "recognize/frame_source.h"
+#include "io/frame_source.h"
 
 namespace ecv::app {
 

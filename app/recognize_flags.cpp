@@ -1,4 +1,4 @@
-#include "recognize/recognize_flags.h"
+#include "app/recognize_flags.h"
 
 #include <algorithm>
 #include <iomanip>
@@ -34,7 +34,7 @@ void ReportSetup(const ModelLibrary& library, const RecognizerOptions& options, 
 void AddRecognizerFlags(CLI::App& command, RecognizerArgs* args) {
   AddDbOption(command, &args->db, "Model library (SQLite), from `ecvpose modeldb build`");
   command.add_option("--models", args->models, "Only these models of the library (default: all)");
-  args->options.ransac.threads = app::AllCores();
+  args->options.threads = app::AllCores();
   AddSettingFlags(command, args);
   command
       .add_flag_callback(

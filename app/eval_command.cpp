@@ -15,6 +15,7 @@
 #include "io/pose_io.h"
 #include "modeldb/model_library.h"
 #include "recognize/evaluation.h"
+#include "recognize/recognition_json.h"
 
 namespace ecv::app {
 namespace {

@@ -1,5 +1,7 @@
-// `ecvpose serve --db lib.sqlite`: one process that loads the library and the meshes once and answers recognition
-// requests, JSON lines on standard input or on a Unix socket (RecognitionService holds the protocol).
+// The Unix-socket and standard-input server of `ecvpose serve`: request lines read as they arrive, clients on threads
+// of their own, one recognition at a time, ended by SIGTERM or SIGINT.
+
+#include "app/socket_server.h"
 
 #include <errno.h>
 #include <pthread.h>
@@ -15,32 +17,26 @@
 #include <cmath>
 #include <csignal>
 #include <cstring>
-#include <filesystem>
-#include <functional>
 #include <iostream>
 #include <list>
-#include <memory>
-#include <mutex>
-#include <optional>
-#include <string>
 #include <thread>
-#include <vector>
 
-#include "app/commands.h"
-#include "app/frame_args.h"
 #include "core/error.h"
 #include "io/files.h"
-#include "recognize/recognition_service.h"
-#include "recognize/recognize_flags.h"
 
 namespace ecv::app {
+
 namespace {
 
 // Set by the signal handler, read by every client thread (a lock-free atomic: safe in a handler).
 std::atomic<bool> stop_requested{false};
 
-// SIGTERM and SIGINT end the service after the request in hand; without SA_RESTART a blocking read or accept returns
-// EINTR, so that a service waiting for a request ends at once.
+}  // namespace
+
+bool StopRequested() {
+  return stop_requested;
+}
+
 void InstallStopHandlers() {
   struct sigaction action {};
   action.sa_handler = [](int) { stop_requested = true; };
@@ -51,17 +47,6 @@ void InstallStopHandlers() {
   signal(SIGPIPE, SIG_IGN);  // a client gone: its write fails with EPIPE instead of ending the service
 }
 
-struct ServeArgs {
-  RecognizerArgs recognizer;
-  std::string socket;
-  std::string socket_mode = "0600";  // octal permissions of the socket file
-  std::vector<std::string> roots;    // folders frames are read below; none: the socket's default
-  int max_clients = 16;              // socket clients served at once
-  double idle_timeout_s = 60.0;      // a socket client that sends nothing for this long is closed; 0: never
-  RequestLimits limits;
-};
-
-// The permission bits an octal text such as "0660" spells; InputError unless it is 1 to 4 octal digits up to 0777.
 mode_t ParseSocketMode(const std::string& text) {
   if (text.empty() || text.size() > 4 || text.find_first_not_of("01234567") != std::string::npos ||
       std::stoi(text, nullptr, 8) > 0777) {
@@ -69,6 +54,8 @@ mode_t ParseSocketMode(const std::string& text) {
   }
   return static_cast<mode_t>(std::stoi(text, nullptr, 8));
 }
+
+namespace {
 
 // Lines of a file descriptor, read as they arrive; nothing once the input ends or a stop is requested.
 class LineReader {
@@ -115,10 +102,9 @@ class LineReader {
   bool timed_out_ = false;
 };
 
-// Answers the requests of one client, a line each, until its input ends, it goes, it sends nothing for longer than
-// the socket's receive timeout (said in an error line) or a stop is requested. `queue`, when given, is held for each
-// answer: one recognition at a time, as recognition uses every core.
-void ServeClient(int in, int out, RecognitionService& service, std::mutex* queue = nullptr) {
+}  // namespace
+
+void ServeClient(int in, int out, RecognitionService& service, std::mutex* queue) {
   LineReader reader(in, service.limits().max_bytes);
   bool too_long = false;
   while (const std::optional<std::string> line = reader.Next(&too_long)) {
@@ -137,6 +123,8 @@ void ServeClient(int in, int out, RecognitionService& service, std::mutex* queue
     WriteAll(out, text.data(), text.size());
   }
 }
+
+namespace {
 
 // The clients of a socket, each served on a thread of its own; at most `max_clients` at once.
 class ClientThreads {
@@ -234,11 +222,11 @@ int ListenOn(const std::string& path, mode_t mode) {
   return fd;
 }
 
-// Clients on threads of their own, each with tracks of its own (`make_service`), one recognition at a time, until a
-// stop is requested. A client past `max_clients` gets an error line and is closed.
-void ServeSocket(const ServeArgs& args, mode_t mode, const std::function<RecognitionService()>& make_service) {
-  const int listener = ListenOn(args.socket, mode);
-  std::cerr << "serve: ready, listening on " << args.socket << '\n';
+}  // namespace
+
+void ServeSocket(const SocketOptions& args, const std::function<RecognitionService()>& make_service) {
+  const int listener = ListenOn(args.path, args.mode);
+  std::cerr << "serve: ready, listening on " << args.path << '\n';
   std::mutex queue;
   const timeval idle = {static_cast<time_t>(args.idle_timeout_s),
                         static_cast<suseconds_t>(std::fmod(args.idle_timeout_s, 1.0) * 1e6)};
@@ -272,81 +260,7 @@ void ServeSocket(const ServeArgs& args, mode_t mode, const std::function<Recogni
   }
   clients.StopAll();
   close(listener);
-  unlink(args.socket.c_str());
-}
-
-// The folders of --root; without one, the working directory for a socket and anywhere for standard input. Said on
-// standard error.
-ReadRoots ServeRoots(const ServeArgs& args) {
-  std::vector<std::string> folders = args.roots;
-  if (folders.empty() && !args.socket.empty()) folders.push_back(".");
-  ReadRoots roots(folders);
-  std::cerr << "serve: frames read " << (folders.empty() ? "anywhere (no --root)" : "below");
-  for (const std::filesystem::path& folder : roots.folders()) std::cerr << ' ' << folder.string();
-  std::cerr << '\n';
-  return roots;
-}
-
-int RunServe(const ServeArgs& args) {
-  const mode_t socket_mode = ParseSocketMode(args.socket_mode);
-  const ReadRoots roots = ServeRoots(args);
-  const StreamRecognizerOptions options =
-      ShareThreads(RecognizerOptionsFromArgs(args.recognizer), args.recognizer.stream);
-  const LoadedRecognizer loaded = LoadRecognizer(args.recognizer, options.track, "serve");
-  const auto make_service = [&] {
-    return RecognitionService(*loaded.recognizer, args.recognizer.stream, args.limits, roots,
-                              MakeRecognizerFactory(*loaded.library, options.search));
-  };
-  InstallStopHandlers();
-  if (!args.socket.empty()) {
-    ServeSocket(args, socket_mode, make_service);
-  } else {
-    RecognitionService service = make_service();
-    std::cerr << "serve: ready, reading requests on standard input\n";
-    ServeClient(STDIN_FILENO, STDOUT_FILENO, service);
-  }
-  std::cerr << "serve: " << (stop_requested ? "stopped" : "input ended") << '\n';
-  return kExitOk;
-}
-
-}  // namespace
-
-CommandAction SetupServeCommand(CLI::App& command) {
-  auto args = std::make_shared<ServeArgs>();
-  AddRecognizerFlags(command, &args->recognizer);
-  command.add_option("--socket", args->socket,
-                     "Serve a Unix socket at this path, each client on a thread and with tracks of its own, one "
-                     "recognition at a time (default: standard input and output)");
-  command.add_option("--max-clients", args->max_clients, "Socket clients served at once: one more gets an error line")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 1024));
-  command
-      .add_option("--idle-timeout", args->idle_timeout_s,
-                  "Seconds a socket client may send nothing before it is closed (0: never)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 86400.0));
-  command.add_option("--root", args->roots,
-                     "Read frames only below this folder (repeatable): regular files whose path, links followed, "
-                     "lies below a --root (default: the working directory with --socket; anywhere on standard input)");
-  command
-      .add_option("--socket-mode", args->socket_mode,
-                  "Permissions of the socket file, octal, whatever the umask: 0600 lets only this user connect, 0660 "
-                  "also the group")
-      ->capture_default_str();
-  command
-      .add_option("--max-request-bytes", args->limits.max_bytes,
-                  "Longest request line, bytes: a longer one gets an error answer and is skipped, not kept")
-      ->capture_default_str()
-      ->check(AtLeastOne());
-  command.footer(
-      "Requests, one JSON object per line: {\"frame\": FRAME}, {\"color\": PATH, \"depth\": PATH, \"depth_scale\": "
-      "S,\n\"camera\": [fx, fy, cx, cy]} or the images themselves, {\"color_png\": BASE64, \"depth_png\": BASE64, "
-      "\"depth_scale\": S,\n\"camera\": [...]}, with optional \"id\" (echoed), \"track\": true|false (default: "
-      "--track) and \"reset\": true.\nEach gets one line: the detections as `recognize --out-json` writes them, or "
-      "{\"id\": ..., \"error\": ...}\n(also for a line past --max-request-bytes, nested deeper than 64 or not UTF-8, "
-      "and for a file outside --root); the service goes on.\nSIGTERM ends the service after the request in hand (exit "
-      "0). Protocol and security: docs/serve.md.");
-  return [args] { return RunServe(*args); };
+  unlink(args.path.c_str());
 }
 
 }  // namespace ecv::app

@@ -1,4 +1,4 @@
-#include "camera/view/shown_frame.h"
+#include "app/view/shown_frame.h"
 
 #include <cstdio>
 #include <stdexcept>

@@ -7,9 +7,9 @@
 
 #include "app/commands.h"
 #include "app/frame_args.h"
+#include "app/sequence_io.h"
 #include "camera/camera_source.h"
 #include "camera/recording.h"
-#include "recognize/sequence_io.h"
 
 namespace ecv::app {
 namespace {

@@ -1,4 +1,4 @@
-#include "camera/view/recognizer_child.h"
+#include "app/view/recognizer_child.h"
 
 #include <errno.h>
 #include <fcntl.h>

@@ -13,6 +13,8 @@
 
 #include "app/commands.h"
 #include "app/frame_args.h"
+#include "app/recognize_flags.h"
+#include "app/sequence_io.h"
 #include "core/byte_neighbours.h"
 #include "core/error.h"
 #include "core/pose.h"
@@ -21,10 +23,9 @@
 #include "io/frame_io.h"
 #include "io/pose_io.h"
 #include "modeldb/model_library.h"
+#include "recognize/recognition_json.h"
 #include "recognize/recognition_stream.h"
-#include "recognize/recognize_flags.h"
 #include "recognize/recognizer.h"
-#include "recognize/sequence_io.h"
 
 namespace ecv::app {
 namespace {
@@ -84,9 +85,10 @@ void PrintDetections(std::ostream& out, const LoadedFrame& loaded, const Recogni
         << d.depth_agreement << ", colour " << d.color_agreement << ", edges " << d.edge_agreement << " of "
         << d.edge_pixels << ", fit " << std::setprecision(1) << 1000.0 * d.surface_error_m << " mm"
         << std::setprecision(2) << ", outline " << d.contour_agreement << ", runs on " << d.continuation
-        << "), inliers " << d.inlier_fraction << ", view " << d.view << ", " << HypothesisSourceName(d.hypothesis)
-        << (d.tracked ? ", tracked" : "") << ", t = [" << std::setprecision(3)
-        << d.camera_from_object.translation().transpose() << "] m" << std::setprecision(2) << '\n';
+        << "), inliers " << d.inlier_fraction << ", view " << d.view << ", "
+        << HypothesisSourceName(d.hypothesis_source) << (d.tracked ? ", tracked" : "") << ", t = ["
+        << std::setprecision(3) << d.camera_from_object.translation().transpose() << "] m" << std::setprecision(2)
+        << '\n';
     for (const GroundTruth& truth : loaded.ground_truth) {
       if (truth.object_name != d.model) continue;
       out << "    vs ground truth: " << std::setprecision(1)

@@ -17,8 +17,8 @@
 
 #include <CLI/CLI.hpp>
 
-#include "camera/view/recognizer_child.h"
-#include "camera/view/viewer.h"
+#include "app/view/recognizer_child.h"
+#include "app/view/viewer.h"
 
 namespace {
 

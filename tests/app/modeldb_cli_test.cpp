@@ -18,8 +18,8 @@
 #include "io/pose_io.h"
 #include "modeldb/model_builder.h"
 #include "modeldb/model_database.h"
+#include "modeldb/modeldb_test_util.h"
 #include "modeldb/sql.h"
-#include "modeldb_test_util.h"
 #include "support/test_data.h"
 
 namespace ecv {

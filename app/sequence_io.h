@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "recognize/frame_source.h"
+#include "io/frame_source.h"
 
 namespace ecv::app {
 
