@@ -17,9 +17,11 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
@@ -45,6 +47,7 @@ struct Run {
   std::string label;
   std::vector<FrameEvaluation> evaluations;        // per frame
   std::vector<std::vector<Detection>> detections;  // per frame
+  std::vector<std::vector<JudgedPose>> judged;     // per frame, with RecognizerOptions::keep_judged
   std::vector<double> ms;                          // per frame
   std::vector<int> frame_index;                    // into the set's frames
 };
@@ -73,13 +76,14 @@ Run RunRecognizer(const ModelLibrary& library, const RecognizerOptions& options,
   const bool track = stream_options.track;
   Recognizer recognizer(library, options);
   RecognitionStream stream(recognizer, stream_options);
-  Run run{label, {}, {}, {}, {}};
+  Run run{label, {}, {}, {}, {}, {}};
   for (size_t i = 0; i < frames.size(); ++i) {
     if (track && frames[i].stream.empty()) continue;  // tracking runs over the streams only
     if (!track || i == 0 || frames[i].stream != frames[i - 1].stream) stream.Reset();
     const RecognitionResult result = stream.Next(frames[i].frame.rgbd);
     run.evaluations.push_back(EvaluateFrame(frames[i].name, result.detections, frames[i].frame.ground_truth, models));
     run.detections.push_back(result.detections);
+    run.judged.push_back(result.judged);
     run.ms.push_back(result.timings_ms.at("total"));
     run.frame_index.push_back(static_cast<int>(i));
     Counts counts;
@@ -298,6 +302,7 @@ struct Settings {
   bool track = false;
   RecognizerSettings recognizer;  // every run: the settings table's flags
   std::string detections;         // JSON Lines of every run's detections, when given
+  std::string judged;             // JSON Lines of every pose the acceptance judged, labelled, when given
 };
 
 // One line per frame of `run`: its set, condition and name, the detections with their verification terms, and
@@ -334,6 +339,48 @@ void AppendDetections(const std::string& path, const Run& run, const std::vector
   }
 }
 
+// How far `detection` lies from the nearest ground-truth instance of its model: ADD (ADD-S for a symmetric model)
+// over the diameter; infinity when the frame holds none.
+double ErrorOverDiameter(const Detection& detection, const LoadedFrame& frame, const std::vector<EvalModel>& models) {
+  const auto model =
+      std::find_if(models.begin(), models.end(), [&](const EvalModel& m) { return m.name == detection.model; });
+  double best = std::numeric_limits<double>::infinity();
+  if (model == models.end()) return best;
+  for (const GroundTruth& truth : frame.ground_truth) {
+    if (truth.object_name != detection.model) continue;
+    const PoseError error = ComputePoseError(model->points, detection.camera_from_object, truth.camera_from_object);
+    best = std::min(best, (model->symmetric ? error.adds_m : error.add_m) / model->diameter_m);
+  }
+  return best;
+}
+
+// One line per pose the acceptance judged in `run`: the frame, the pose's evidence (the detection's JSON fields),
+// the verdict, and the label: right when ADD (ADD-S) < 0.1 x diameter, the error, the model's properties.
+void AppendJudged(const std::string& path, const Run& run, const std::vector<BenchFrame>& frames,
+                  const std::vector<EvalModel>& models, const std::set<std::string>& grey) {
+  std::ofstream out(path, std::ios::app);
+  if (!out) ThrowInputError(path, "--judged", "a file that can be written");
+  for (size_t k = 0; k < run.judged.size(); ++k) {
+    const BenchFrame& frame = frames[static_cast<size_t>(run.frame_index[k])];
+    RecognitionResult result;
+    result.judged = run.judged[k];
+    const nlohmann::json records = RecognitionToJson(result)["judged"];
+    for (size_t j = 0; j < run.judged[k].size(); ++j) {
+      const Detection& detection = run.judged[k][j].detection;
+      const double error = ErrorOverDiameter(detection, frame.frame, models);
+      nlohmann::json line = {{"run", run.label},
+                             {"set", frame.set},
+                             {"condition", frame.condition},
+                             {"frame", frame.name},
+                             {"right", error < 0.1},
+                             {"error_over_diameter", std::isfinite(error) ? error : -1.0},
+                             {"grey", grey.count(detection.model) > 0}};
+      line.update(records[j]);
+      out << line.dump() << '\n';
+    }
+  }
+}
+
 int Main(int argc, char** argv) {
   CLI::App app("Recognition on the generalisation set: rendered scenes, composites of real frames, cast light");
   Settings s;
@@ -355,6 +402,9 @@ int Main(int argc, char** argv) {
   app.add_option("--detections", s.detections,
                  "JSON Lines file every run's detections are appended to, per frame with their verification terms "
                  "and which were right, with each found or wrongly placed object's pose errors");
+  app.add_option("--judged", s.judged,
+                 "JSON Lines file every pose the acceptance judged is appended to, one per line, with its evidence, "
+                 "the verdict and whether it was right (ADD, ADD-S for symmetric models, < 0.1 x diameter)");
   s.recognizer.options.threads = 2;  // the benchmark machine's cores
   AddSettingFlags(app, &s.recognizer, {"hypotheses", "track", "search-beside"},
                   "Settings of every run (as `ecvpose recognize` takes them)");
@@ -423,6 +473,7 @@ int Main(int argc, char** argv) {
   };
   const auto add_run = [&](Run run) {
     if (!s.detections.empty()) AppendDetections(s.detections, run, frames);
+    if (!s.judged.empty()) AppendJudged(s.judged, run, frames, models, grey);
     runs.push_back(std::move(run));
     if (runs.size() == 1 && !s.figures.empty())
       WriteFigures(library, runs.front(), frames, s.figures, tag, s.figure_format);
@@ -431,6 +482,7 @@ int Main(int argc, char** argv) {
   for (const std::string& source : s.hypotheses) {
     for (const uint64_t seed : s.seeds) {
       RecognizerOptions options = s.recognizer.options;
+      options.keep_judged = !s.judged.empty();
       options.point_pairs.source = ParseHypothesisSource(source, "--hypotheses");
       options.ransac.seed = seed;
       const std::string label = source + ", seed " + std::to_string(seed);

@@ -32,8 +32,14 @@ struct Detection {
   double visible_fraction = 0.0;   ///< share of the rendered pixels the scene can show (not hidden, with depth)
   /// Of the rendered model's texture edges on those, the share the scene shows (0: none predicted) ...
   double edge_agreement = 0.0;
-  int edge_pixels = 0;   ///< ... and how many were predicted
-  bool tracked = false;  ///< found from a prior (the previous frame's pose), without RANSAC
+  int edge_pixels = 0;  ///< ... and how many were predicted
+  /// Geometric evidence (VerifyOptions, not yet in the score): the share of the visible rendered surface the scene's
+  /// points and normals confirm; ...
+  double explained_surface = 0.0;
+  double free_space_violation = 0.0;  ///< ... the share where the scene is seen far behind it; ...
+  double occluding_contour = 0.0;     ///< ... the share of the seen outline where the scene steps back behind it, ...
+  double creased_contour = 0.0;       ///< ... and where, not stepping back, the scene's surface turns
+  bool tracked = false;               ///< found from a prior (the previous frame's pose), without RANSAC
   /// Frames it has been followed since a search of its model last found it (0: a search found it in this frame);
   /// TrackingOptions::confirm_every.
   int frames_followed = 0;
@@ -43,6 +49,12 @@ struct Detection {
   /// Where its pose came from: kContext (view ranking and RANSAC) or kPpf (point pair features); a tracked
   /// detection keeps its first detection's.
   HypothesisSource hypothesis_source = HypothesisSource::kContext;
+};
+
+/// A pose the acceptance (min_score, min_visible_fraction) judged, with its evidence, and the verdict.
+struct JudgedPose {
+  Detection detection;
+  bool accepted = false;
 };
 
 /// Detections of one frame and where the time went.
@@ -56,6 +68,9 @@ struct RecognitionResult {
   /// With a search beside the tracking (StreamOptions::search_beside): how many frames before this one the frame lay
   /// whose search's detections joined this frame's priors; -1: none did.
   int searched_frames_ago = -1;
+  /// With RecognizerOptions::keep_judged: each model's best pose for each instance searched for, and each prior
+  /// followed, before overlaps are suppressed; per model in library order.
+  std::vector<JudgedPose> judged;
 };
 
 /// One library view as view ranking saw it in a frame.

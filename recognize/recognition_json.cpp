@@ -5,32 +5,51 @@
 
 namespace ecv {
 
+namespace {
+
+nlohmann::json DetectionToJson(const Detection& d) {
+  return {{"model", d.model},
+          {"score", d.score},
+          {"camera_from_object", PoseToJson(d.camera_from_object)},
+          {"inlier_fraction", d.inlier_fraction},
+          {"fit_error", d.fit_error_m},
+          {"view", d.view},
+          {"depth_agreement", d.depth_agreement},
+          {"color_agreement", d.color_agreement},
+          {"visible_fraction", d.visible_fraction},
+          {"surface_error", d.surface_error_m},
+          {"contour_agreement", d.contour_agreement},
+          {"continuation", d.continuation},
+          {"edge_agreement", d.edge_agreement},
+          {"edge_pixels", d.edge_pixels},
+          {"explained_surface", d.explained_surface},
+          {"free_space_violation", d.free_space_violation},
+          {"occluding_contour", d.occluding_contour},
+          {"creased_contour", d.creased_contour},
+          {"tracked", d.tracked},
+          {"confirmed", d.confirmed},
+          {"hypothesis", HypothesisSourceName(d.hypothesis_source)}};
+}
+
+}  // namespace
+
 nlohmann::json RecognitionToJson(const RecognitionResult& result) {
   nlohmann::json detections = nlohmann::json::array();
-  for (const Detection& d : result.detections) {
-    detections.push_back({{"model", d.model},
-                          {"score", d.score},
-                          {"camera_from_object", PoseToJson(d.camera_from_object)},
-                          {"inlier_fraction", d.inlier_fraction},
-                          {"fit_error", d.fit_error_m},
-                          {"view", d.view},
-                          {"depth_agreement", d.depth_agreement},
-                          {"color_agreement", d.color_agreement},
-                          {"visible_fraction", d.visible_fraction},
-                          {"surface_error", d.surface_error_m},
-                          {"contour_agreement", d.contour_agreement},
-                          {"continuation", d.continuation},
-                          {"edge_agreement", d.edge_agreement},
-                          {"edge_pixels", d.edge_pixels},
-                          {"tracked", d.tracked},
-                          {"confirmed", d.confirmed},
-                          {"hypothesis", HypothesisSourceName(d.hypothesis_source)}});
-  }
+  for (const Detection& d : result.detections) detections.push_back(DetectionToJson(d));
   nlohmann::json json = {{"detections", detections},
                          {"timings_ms", result.timings_ms},
                          {"scene_primitives", result.scene_primitives},
                          {"views_tried", result.views_tried}};
   if (result.searched_frames_ago >= 0) json["searched_frames_ago"] = result.searched_frames_ago;
+  if (!result.judged.empty()) {
+    nlohmann::json judged = nlohmann::json::array();
+    for (const JudgedPose& pose : result.judged) {
+      nlohmann::json item = DetectionToJson(pose.detection);
+      item["accepted"] = pose.accepted;
+      judged.push_back(std::move(item));
+    }
+    json["judged"] = std::move(judged);
+  }
   return json;
 }
 

@@ -177,6 +177,7 @@ class Recognizer::Impl {
       times += searches[m].times;
       if (searches[m].views_tried >= 0) result.views_tried[models_[m].record.name] = searches[m].views_tried;
       for (VerifiedPose& verified : models[m].instances) candidates.push_back(std::move(verified));
+      for (JudgedPose& judged : models[m].judged) result.judged.push_back(std::move(judged));
     }
     const Clock::time_point stage = Clock::now();
     result.detections = SuppressOverlaps(frame.depth.size(), std::move(candidates));
@@ -205,6 +206,13 @@ class Recognizer::Impl {
            detection.visible_fraction >= options_.verify.min_visible_fraction;
   }
 
+  // Accepted, the verdict kept in `model` with keep_judged.
+  bool Judge(const Detection& detection, ModelInFrame* model) const {
+    const bool accepted = Accepted(detection);
+    if (options_.keep_judged) model->judged.push_back({detection, accepted});
+    return accepted;
+  }
+
   ModelSearch Search(size_t model, const Scene& scene, int ransac_threads) {
     return ModelSearch(
         models_[model].record, options_, scene,
@@ -220,7 +228,7 @@ class Recognizer::Impl {
       std::vector<Followed> followed;
       for (const Detection* prior : model.priors) {
         VerifiedPose tracked = Track(m, *prior, scene);
-        if (Accepted(tracked.detection)) {
+        if (Judge(tracked.detection, &model)) {
           followed.push_back({std::move(tracked), !prior->tracked});
         } else {
           model.lost = true;
@@ -265,7 +273,7 @@ class Recognizer::Impl {
       std::optional<VerifiedPose> best =
           search.BestPose(views, first ? options_.give_up_after_views : 0, model->covered, &ranked, &result.times);
       if (best && options_.twins.enabled) best = BestTwin(m, scene, std::move(*best), &result.times);
-      if (!best || !Accepted(best->detection)) break;
+      if (!best || !Judge(best->detection, model)) break;
       AddInstance(std::move(*best), options_.dense_stride_px, scene.frame->depth.size(), model);
     }
     result.views_tried = static_cast<int>(
@@ -391,7 +399,7 @@ class Recognizer::Impl {
     ParallelFor(wanted.size(), options_.threads, [&](size_t i) {
       std::optional<VerifiedPose> best = BestPointPairPose(wanted[i], scene, points, &model_times[i]);
       if (best && options_.twins.enabled) best = BestTwin(wanted[i], scene, std::move(*best), &model_times[i]);
-      if (best && Accepted(best->detection)) {
+      if (best && Judge(best->detection, &(*models)[wanted[i]])) {
         AddInstance(std::move(*best), options_.dense_stride_px, scene.frame->depth.size(), &(*models)[wanted[i]]);
       }
     });

@@ -162,6 +162,9 @@ struct RecognizerOptions {
   int max_instances = 1;
   /// Views tried for each instance after a model's first: it is known to be in the frame (0: views_per_model).
   int later_instance_views = 21;
+  /// Keep every pose the acceptance judged in RecognitionResult::judged, accepted or not: the records an acceptance
+  /// is learned from.
+  bool keep_judged = false;
 
   /// The paper's RANSAC with adaptive stopping, poses ranked by agreeing correspondences, at most 10 000 samples
   /// per view, and a sample counted only when 1 % of the correspondences (at least 1) agree with it.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <utility>
 
 #include <Eigen/Dense>
 #include <opencv2/imgproc.hpp>
@@ -168,6 +169,112 @@ OutlineOnSteps OutlineOnDepthSteps(const cv::Mat& rendered_depth, int stride, co
     }
   }
   return outline;
+}
+
+cv::Mat DepthNormals(const cv::Mat& depth, const PinholeCamera& camera, int reach, double max_step_m) {
+  if (depth.type() != CV_32FC1) ThrowInputError("depth normals", "depth", "a CV_32FC1 image in metres");
+  if (reach < 1) ThrowInputError("depth normals", "reach", "at least 1 pixel", std::to_string(reach));
+  if (camera.width != depth.cols || camera.height != depth.rows) {
+    ThrowInputError("depth normals", "camera", "the depth image's size");
+  }
+  const auto max_step = static_cast<float>(max_step_m);
+  cv::Mat normals(depth.size(), CV_32FC3, cv::Scalar::all(0.0));
+  auto point = [&](int u, int v, float z) -> Eigen::Vector3f {
+    return camera.BackProject(Eigen::Vector2d(u, v), z).cast<float>();
+  };
+  for (int v = reach; v + reach < depth.rows; ++v) {
+    for (int u = reach; u + reach < depth.cols; ++u) {
+      const float z = depth.at<float>(v, u);
+      if (z <= 0.0F) continue;
+      const float left = depth.at<float>(v, u - reach), right = depth.at<float>(v, u + reach);
+      const float up = depth.at<float>(v - reach, u), down = depth.at<float>(v + reach, u);
+      bool surface = true;
+      for (const float neighbour : {left, right, up, down}) {
+        surface = surface && neighbour > 0.0F && std::abs(neighbour - z) <= max_step;
+      }
+      if (!surface) continue;
+      Eigen::Vector3f normal = (point(u + reach, v, right) - point(u - reach, v, left))
+                                   .cross(point(u, v + reach, down) - point(u, v - reach, up));
+      if (normal.norm() <= 0.0F) continue;
+      normal.normalize();
+      if (normal.dot(point(u, v, z)) > 0.0F) normal = -normal;  // facing the camera
+      normals.at<cv::Vec3f>(v, u) = cv::Vec3f(normal.x(), normal.y(), normal.z());
+    }
+  }
+  return normals;
+}
+
+void OccludingContourOptions::Check() const {
+  auto require = [](bool ok, const char* field, const char* expected) {
+    if (!ok) ThrowInputError("occluding contour options", field, expected);
+  };
+  require(step_m > 0.0, "step_m", "> 0 m");
+  require(gap >= 1 && gap <= 20, "gap", "in [1, 20] samples");
+  require(crease_angle_deg > 0.0 && crease_angle_deg < 180.0, "crease_angle_deg", "in (0, 180) degrees");
+}
+
+OccludingContour OccludingContourSteps(const cv::Mat& rendered_depth, int stride, const cv::Mat& scene_depth,
+                                       const cv::Mat& scene_normals, double surface_tolerance_m,
+                                       const OccludingContourOptions& options) {
+  if (rendered_depth.type() != CV_32FC1 || scene_depth.type() != CV_32FC1) {
+    ThrowInputError("occluding contour", "rendered_depth/scene_depth", "CV_32FC1 images in metres");
+  }
+  if (!scene_normals.empty() && (scene_normals.type() != CV_32FC3 || scene_normals.size() != rendered_depth.size())) {
+    ThrowInputError("occluding contour", "scene_normals", "a CV_32FC3 image of the rendered depth's size");
+  }
+  if (stride < 1) ThrowInputError("occluding contour", "stride", "at least 1");
+  options.Check();
+  const auto tolerance = static_cast<float>(surface_tolerance_m);
+  const auto step = static_cast<float>(options.step_m);
+  const auto crease_cos = static_cast<float>(std::cos(options.crease_angle_deg * 3.14159265358979323846 / 180.0));
+  auto inside_image = [&](int u, int v) {
+    return u >= 0 && v >= 0 && u < rendered_depth.cols && v < rendered_depth.rows;
+  };
+  // Beyond the image counts as on the object: where the image cuts an object off, that is not its outline.
+  auto on_object = [&](int u, int v) { return !inside_image(u, v) || rendered_depth.at<float>(v, u) > 0.0F; };
+  // The scene's depth at sample (u, v) of the render; -1 outside the frame.
+  auto scene_at = [&](int u, int v) {
+    const int scene_u = u * stride, scene_v = v * stride;
+    if (scene_u < 0 || scene_v < 0 || scene_u >= scene_depth.cols || scene_v >= scene_depth.rows) return -1.0F;
+    return scene_depth.at<float>(scene_v, scene_u);
+  };
+  // The scene's normal at sample (u, v) of the render; zero outside or where the depth does not tell.
+  auto normal_at = [&](int u, int v) { return inside_image(u, v) ? scene_normals.at<cv::Vec3f>(v, u) : cv::Vec3f(); };
+  OccludingContour contour;
+  for (int v = 0; v < rendered_depth.rows; ++v) {
+    for (int u = 0; u < rendered_depth.cols; ++u) {
+      const float model_z = rendered_depth.at<float>(v, u);
+      if (model_z <= 0.0F) continue;
+      Eigen::Vector2f outward = Eigen::Vector2f::Zero();  // towards the neighbours off the object
+      for (const auto& [du, dv] : {std::pair{-1, 0}, std::pair{1, 0}, std::pair{0, -1}, std::pair{0, 1}}) {
+        if (!on_object(u + du, v + dv)) outward += Eigen::Vector2f(static_cast<float>(du), static_cast<float>(dv));
+      }
+      const float scene_z = scene_at(u, v);
+      if (outward.isZero() || scene_z < 0.0F) continue;               // inside, or an outline beyond the frame
+      if (scene_z > 0.0F && scene_z < model_z - tolerance) continue;  // hidden
+      ++contour.seen;
+      if (scene_z <= 0.0F || std::abs(scene_z - model_z) > tolerance) continue;  // the scene is not the model here
+      outward.normalize();
+      auto along = [&](int k) {  // the sample k steps outwards (k < 0: inwards)
+        return cv::Point(u + static_cast<int>(std::lround(k * outward.x())),
+                         v + static_cast<int>(std::lround(k * outward.y())));
+      };
+      bool stepping_back = false;
+      for (int k = 1; k <= options.gap && !stepping_back; ++k) {
+        const float beyond = scene_at(along(k).x, along(k).y);
+        stepping_back = beyond == 0.0F || beyond > scene_z + step;
+      }
+      if (stepping_back) {
+        ++contour.stepping_back;
+        continue;
+      }
+      if (scene_normals.empty()) continue;
+      const cv::Point in = along(-options.gap), out = along(options.gap);
+      const cv::Vec3f inner = normal_at(in.x, in.y), outer = normal_at(out.x, out.y);
+      if (inner != cv::Vec3f() && outer != cv::Vec3f() && inner.dot(outer) < crease_cos) ++contour.creased;
+    }
+  }
+  return contour;
 }
 
 double ContourFactor(const OutlineOnSteps& outline, double free, double falloff, int min_seen) {

@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
+#include "core/camera.h"
 #include "ecv/primitives.h"
 #include "registration/ransac.h"
 
@@ -111,6 +112,44 @@ struct OutlineContinuation {
 /// do not fit.
 OutlineContinuation SurfaceContinuation(const cv::Mat& rendered_depth, int stride, const cv::Mat& scene_depth,
                                         double surface_tolerance_m, const ContinuationOptions& options = {});
+
+/// Unit surface normals of a depth image (CV_32FC1 metres, 0 = no depth) that `camera` sees: from the points `reach`
+/// pixels to either side and above and below, turned to face the camera. CV_32FC3 (camera frame); (0, 0, 0) where a
+/// neighbour has no depth or lies more than `max_step_m` nearer or further than the pixel (a depth step, not a
+/// surface). Throws InputError on another image type, a reach below 1 or a camera of another size.
+cv::Mat DepthNormals(const cv::Mat& depth, const PinholeCamera& camera, int reach, double max_step_m);
+
+/// Outline pixels of a rendered pose that the scene shows, and at how many of them its surface ends: it steps back
+/// behind the object, or else it turns (a crease, where an object stands on a table).
+struct OccludingContour {
+  int seen = 0;
+  int stepping_back = 0;
+  int creased = 0;
+  double SteppingBack() const { return seen > 0 ? static_cast<double>(stepping_back) / seen : 0.0; }
+  double Creased() const { return seen > 0 ? static_cast<double>(creased) / seen : 0.0; }
+};
+
+/// Where OccludingContourSteps takes the scene's surface to end at an outline pixel.
+struct OccludingContourOptions {
+  double step_m = 0.01;  ///< it steps back by more than this (or has no depth), metres, ...
+  int gap = 3;           ///< ... within this many samples beyond the outline; ...
+  /// ... or its normals this many samples inside and beyond differ by more than this, degrees.
+  double crease_angle_deg = 30.0;
+
+  /// Throws InputError on values outside their ranges.
+  void Check() const;
+};
+
+/// Whether a pose's outline is where the scene's surface ends, with its orientation. For each outline pixel of
+/// `rendered_depth` (as in OutlineOnDepthSteps) the scene does not hide and shows on the model's surface (within
+/// `surface_tolerance_m`): the scene steps back behind the object there, or else it creases (`scene_normals`,
+/// DepthNormals at the render's size; empty: no creases). A right pose's outline is where the object hides what lies
+/// behind it or meets what it stands on; a pose laid flat on a larger surface, or shifted over a table, has the same
+/// surface on both sides of its outline, and an outline along another object's edge has that edge the wrong way
+/// round. Throws InputError when the images do not fit.
+OccludingContour OccludingContourSteps(const cv::Mat& rendered_depth, int stride, const cv::Mat& scene_depth,
+                                       const cv::Mat& scene_normals, double surface_tolerance_m,
+                                       const OccludingContourOptions& options = {});
 
 /// Verification's contour factor: 1 when fewer than `min_seen` outline pixels are seen (an object cut off by the
 /// image all round, or hidden but for a patch: the outline cannot tell), else 1 from a share of `free` on the

@@ -25,6 +25,7 @@ struct ModelInFrame {
   bool search = false;
   /// Tracked instances due for confirmation, set aside while their model is searched as if it had no priors.
   std::vector<VerifiedPose> to_confirm;
+  std::vector<JudgedPose> judged;  ///< with RecognizerOptions::keep_judged: the poses its acceptance judged
 };
 
 /// Adds `verified` to `model`'s instances and its surface (sampled every `stride` pixels) to the covered pixels.

@@ -10,6 +10,11 @@
 #include "recognize/detection.h"
 
 namespace ecv {
+namespace {
+
+constexpr double kRadiansPerDegree = 3.14159265358979323846 / 180.0;
+
+}  // namespace
 
 void VerifyOptions::Check() const {
   auto require = [](bool ok, const char* field, const char* expected) {
@@ -30,6 +35,11 @@ void VerifyOptions::Check() const {
   require(min_edge_pixels >= 1, "min_edge_pixels", "at least 1");
   edge.Check();
   require(plain_appearance >= 0.0 && plain_appearance <= 1.0, "plain_appearance", "in [0, 1] (0: by colours)");
+  require(explain_distance_m > 0.0, "explain_distance_m", "> 0 m");
+  require(explain_angle_deg > 0.0 && explain_angle_deg <= 90.0, "explain_angle_deg", "in (0, 90] degrees");
+  require(normal_reach_px >= 1 && normal_reach_px <= 20, "normal_reach_px", "in [1, 20] samples");
+  require(free_space_margin_m > 0.0, "free_space_margin_m", "> 0 m");
+  occluding.Check();
   require(min_score >= 0.0 && min_score <= 1.0, "min_score", "in [0, 1]");
   require(min_visible_fraction >= 0.0 && min_visible_fraction <= 1.0, "min_visible_fraction", "in [0, 1]");
   plane_patch.Check();
@@ -56,6 +66,14 @@ VerificationFrame MakeVerificationFrame(const RgbdFrame& frame, const VerifyOpti
     for (int u = 0; u < sampled.cols; ++u) sampled.at<uchar>(v, u) = grey.at<uchar>(v * stride, u * stride);
   }
   verification.gradient = GreyGradient(sampled);
+  verification.camera = frame.camera.Sampled(stride);
+  cv::Mat sampled_depth(sampled.size(), CV_32FC1);
+  for (int v = 0; v < sampled.rows; ++v) {
+    for (int u = 0; u < sampled.cols; ++u)
+      sampled_depth.at<float>(v, u) = frame.depth.at<float>(v * stride, u * stride);
+  }
+  verification.normals =
+      DepthNormals(sampled_depth, verification.camera, options.normal_reach_px, options.depth_step_m);
   return verification;
 }
 
@@ -83,6 +101,11 @@ PoseEvidence MeasurePose(const RenderedPose& rendered, const VerificationFrame& 
   cv::Mat interior;
   cv::erode(rendered.depth > 0.0F, interior, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(5, 5)));
   std::vector<cv::Point> interior_surface;  // surface pixels inside, at the stride
+  const cv::Mat model_normals =
+      DepthNormals(rendered.depth, frame.camera, options.normal_reach_px, options.depth_step_m);
+  const auto explain_distance = static_cast<float>(options.explain_distance_m);
+  const auto min_cos = static_cast<float>(std::cos(options.explain_angle_deg * kRadiansPerDegree));
+  const auto free_space_margin = static_cast<float>(options.free_space_margin_m);
   for (int v = 0; v < rendered.depth.rows; ++v) {
     for (int u = 0; u < rendered.depth.cols; ++u) {
       const float model_z = rendered.depth.at<float>(v, u);
@@ -92,6 +115,15 @@ PoseEvidence MeasurePose(const RenderedPose& rendered, const VerificationFrame& 
       const float scene_z = frame.depth.at<float>(scene_v, scene_u);
       if (scene_z <= 0.0F || scene_z < model_z - tolerance) continue;  // no measurement, or hidden
       ++evidence.visible;
+      if (scene_z > model_z + free_space_margin) ++evidence.behind;
+      const cv::Vec3f& model_normal = model_normals.at<cv::Vec3f>(v, u);
+      if (model_normal != cv::Vec3f()) {
+        ++evidence.normal_pixels;
+        if (std::abs(scene_z - model_z) <= explain_distance &&
+            model_normal.dot(frame.normals.at<cv::Vec3f>(v, u)) >= min_cos) {
+          ++evidence.explained;
+        }
+      }
       if (std::abs(scene_z - model_z) > tolerance) continue;
       residual_sum += std::abs(scene_z - model_z);
       evidence.surface.emplace_back(scene_u, scene_v);
@@ -110,6 +142,8 @@ PoseEvidence MeasurePose(const RenderedPose& rendered, const VerificationFrame& 
   evidence.edges = CompareEdges(GreyGradient(model_grey), frame.gradient, interior_surface, options.edge);
   evidence.outline =
       OutlineOnDepthSteps(rendered.depth, stride, frame.depth, frame.depth_steps, options.depth_tolerance_m);
+  evidence.occluding = OccludingContourSteps(rendered.depth, stride, frame.depth, frame.normals,
+                                             options.depth_tolerance_m, options.occluding);
   if (options.continuation_falloff > 0.0) {
     evidence.continuation =
         SurfaceContinuation(rendered.depth, stride, frame.depth, options.depth_tolerance_m, options.continuation);
@@ -133,6 +167,12 @@ void ScorePose(const PoseEvidence& evidence, const VerifyOptions& options, bool 
   detection->surface_error_m = evidence.surface_error_m;
   detection->contour_agreement = evidence.outline.Share();
   detection->continuation = evidence.continuation.Share();
+  detection->explained_surface =
+      evidence.normal_pixels > 0 ? static_cast<double>(evidence.explained) / evidence.normal_pixels : 0.0;
+  detection->free_space_violation =
+      evidence.visible > 0 ? static_cast<double>(evidence.behind) / evidence.visible : 0.0;
+  detection->occluding_contour = evidence.occluding.SteppingBack();
+  detection->creased_contour = evidence.occluding.Creased();
   const double contour =
       ContourFactor(evidence.outline, options.contour_free, options.contour_falloff, options.min_outline_samples);
   const double appearance =

@@ -49,6 +49,18 @@ struct VerifyOptions {
   /// object's print: its appearance term is this instead, and it is judged by its geometry (0: by its colours, as
   /// any model).
   double plain_appearance = 0.0;
+  /// The geometric evidence a pose's record carries (not yet part of the score): a visible rendered point is
+  /// explained by the scene point on its ray within explain_distance_m (metres) whose normal lies within
+  /// explain_angle_deg (degrees) of the rendered surface's ...
+  double explain_distance_m = 0.005;
+  double explain_angle_deg = 30.0;
+  /// ... normals from the points normal_reach_px samples away (at the dense stride), not across a depth step;
+  int normal_reach_px = 2;
+  /// ... the scene violates the pose's free space where it is seen more than free_space_margin_m behind the model's
+  /// surface, metres; ...
+  double free_space_margin_m = 0.03;
+  /// ... and where the scene's surface ends at the pose's outline.
+  OccludingContourOptions occluding;
   double min_score = 0.3;             ///< poses below are not detections
   double min_visible_fraction = 0.1;  ///< nor poses of which the scene can show less than this share
   /// A pose whose surface is one patch of a larger scene plane scores 0 (PatchOfLargerPlane): the depth shows
@@ -69,11 +81,13 @@ struct VerifyOptions {
 
 /// The frame as verification compares rendered poses with it; made once per frame (MakeVerificationFrame).
 struct VerificationFrame {
-  cv::Mat depth;        ///< the frame's depth, CV_32FC1 metres
-  cv::Mat color;        ///< the frame's colours blurred by color_blur_px, CV_8UC3 RGB
-  cv::Mat depth_steps;  ///< DepthSteps of the frame, grown by 2 pixels
-  cv::Mat gradient;     ///< GreyGradient of `color` sampled every `stride` pixels
-  int stride = 1;       ///< renders are compared at every stride-th pixel of the frame
+  cv::Mat depth;         ///< the frame's depth, CV_32FC1 metres
+  cv::Mat color;         ///< the frame's colours blurred by color_blur_px, CV_8UC3 RGB
+  cv::Mat depth_steps;   ///< DepthSteps of the frame, grown by 2 pixels
+  cv::Mat gradient;      ///< GreyGradient of `color` sampled every `stride` pixels
+  int stride = 1;        ///< renders are compared at every stride-th pixel of the frame
+  PinholeCamera camera;  ///< the frame's camera at the stride (PinholeCamera::Sampled)
+  cv::Mat normals;       ///< DepthNormals of the frame's depth at the stride, CV_32FC3
 };
 
 /// The frame's verification images for renders at every `stride`-th pixel.
@@ -97,6 +111,11 @@ struct PoseEvidence {
   EdgeAgreement edges;               ///< the model's texture edges inside its silhouette, and those the scene shows
   OutlineOnSteps outline;            ///< the seen outline, and how much of it lies on scene depth steps
   OutlineContinuation continuation;  ///< the judged outline, and across how much of it the scene's surface runs on
+  /// Visible pixels with a rendered normal, and those the scene explains (explain_distance_m, explain_angle_deg).
+  int normal_pixels = 0;
+  int explained = 0;
+  int behind = 0;              ///< visible pixels where the scene lies more than free_space_margin_m behind the model
+  OccludingContour occluding;  ///< the seen outline, and where the scene steps back behind it
 };
 
 /// Compares `rendered` with `frame` (made with the same stride); `model_to_scene` maps the rendered colours (a

@@ -34,6 +34,10 @@ def test_finds_the_three_objects_of_the_demo_frame_at_their_true_poses(demo_libr
         error_m = np.linalg.norm(pose[:3, 3] - truth[detection.model][:3, 3])
         assert error_m < MAX_TRANSLATION_M, (detection.model, error_m)
         assert rotation_deg(pose, truth[detection.model]) < MAX_ROTATION_DEG, detection.model
+        # At a right pose the frame explains most of the surface and is not seen through it.
+        assert detection.explained_surface > 0.4, (detection.model, detection.explained_surface)
+        assert detection.free_space_violation < 0.1, (detection.model, detection.free_space_violation)
+        assert 0.0 <= detection.occluding_contour + detection.creased_contour <= 1.0
     timings = recognizer.last_timings_ms
     assert timings["total"] > 0.0 and "verify" in timings
 

@@ -267,6 +267,34 @@ TEST_F(RecognizeEndToEnd, SameSeedSameDetections) {
   EXPECT_EQ(outputs[0], outputs[1]) << "one and two threads, the same seed";
 }
 
+// keep_judged keeps every pose the acceptance judged: on the demo frame each model's best pose, the three accepted
+// ones being the detections; with a bar no pose reaches, the same poses, all rejected, and no detections.
+TEST_F(RecognizeEndToEnd, KeepsEveryJudgedPoseWithItsVerdict) {
+  const ModelLibrary library = Library();
+  const LoadedFrame frame = LoadYcbvFrame(Frame());
+  RecognizerOptions options;
+  options.keep_judged = true;
+  const RecognitionResult found = Recognizer(library, options).Recognize(frame.rgbd);
+  ASSERT_EQ(found.detections.size(), 3U);
+  std::vector<std::string> accepted;
+  for (const JudgedPose& pose : found.judged) {
+    if (pose.accepted) accepted.push_back(pose.detection.model);
+  }
+  std::vector<std::string> detected;
+  for (const Detection& detection : found.detections) detected.push_back(detection.model);
+  std::sort(accepted.begin(), accepted.end());
+  std::sort(detected.begin(), detected.end());
+  EXPECT_EQ(accepted, detected);
+  EXPECT_EQ(RecognitionToJson(found)["judged"].size(), found.judged.size());
+  EXPECT_FALSE(Recognizer(library, RecognizerOptions()).Recognize(frame.rgbd).judged.size() > 0) << "kept unasked";
+
+  options.verify.min_score = 0.99;
+  const RecognitionResult none = Recognizer(library, options).Recognize(frame.rgbd);
+  EXPECT_TRUE(none.detections.empty());
+  ASSERT_GE(none.judged.size(), 3U);  // each model's best, the first instance of each
+  for (const JudgedPose& pose : none.judged) EXPECT_FALSE(pose.accepted) << pose.detection.model;
+}
+
 TEST_F(RecognizeEndToEnd, TheSameFrameTwiceGivesTheSameDetectionsAndTheFrameIsLeftAlone) {
   const ModelLibrary library = Library();
   const LoadedFrame frame = LoadYcbvFrame(Frame());
@@ -529,6 +557,35 @@ TEST_F(RecognizeEndToEnd, APoseAFewMillimetresOffTheSurfaceScoresZeroThroughItsR
   EXPECT_EQ(off.score, 0.0);
   options.verify.residual_falloff_m = 0.0;  // no factor: depth agreement and colour alone pass it
   EXPECT_GT(verify(options, back).score, 0.3);
+}
+
+// The geometric evidence of a pose moves the right way off the ground truth: the cracker box 9 mm back along its
+// line of sight lies within the depth tolerance, but the scene no longer explains its surface; 2 cm sideways, part
+// of it hangs over the table seen far behind it, and its outline there no longer hides anything.
+TEST_F(RecognizeEndToEnd, TheGeometricEvidenceFallsOffTheTruePose) {
+  const ModelLibrary library = Library({"003_cracker_box"});
+  const LoadedFrame frame = LoadYcbvFrame(Frame());
+  const GroundTruth* truth = TruthOf(frame, "003_cracker_box");
+  ASSERT_NE(truth, nullptr);
+  RecognizerOptions options;
+  options.refine = false;  // verified at the prior's pose as it is
+  options.verify.min_score = 0.0;
+  options.verify.min_visible_fraction = 0.0;
+  auto verify = [&](const Eigen::Isometry3d& pose) {
+    return test::VerifyPrior(library, options, frame.rgbd, "003_cracker_box", pose);
+  };
+  const Detection right = verify(truth->camera_from_object);
+  Eigen::Isometry3d back = truth->camera_from_object, aside = truth->camera_from_object;
+  back.translation() += 0.009 * back.translation().normalized();
+  aside.translation() += 0.02 * Eigen::Vector3d::UnitX();
+  const Detection behind = verify(back), beside = verify(aside);
+  // Depth agreement alone keeps the pose 9 mm back (APoseAFewMillimetresOff...); the explained surface does not.
+  EXPECT_GT(right.explained_surface, 0.6);
+  EXPECT_LT(behind.explained_surface, right.explained_surface - 0.3);
+  EXPECT_LT(beside.explained_surface, right.explained_surface - 0.3);
+  EXPECT_LT(right.free_space_violation, 0.05);
+  EXPECT_GT(beside.free_space_violation, right.free_space_violation + 0.1);
+  EXPECT_GT(right.occluding_contour, beside.occluding_contour + 0.2);
 }
 
 // The demo frame (video 0001) with the mustard bottle of video 0002's first frame pasted in over the cracker box,

@@ -289,6 +289,98 @@ TEST(SurfaceContinuation, IsZeroForABoxStandingOutAndOneForABoxLaidOnALargerFace
   EXPECT_LT(edge.Share(), 0.9);
 }
 
+TEST(OccludingContourSteps, IsOneForABoxStandingOutAndZeroLaidOnAFaceShiftedOntoTheTableOrBehindAnEdge) {
+  const cv::Rect box(20, 20, 20, 20);
+  const cv::Mat scene = TableWithBox(box);
+  const OccludingContour standing = OccludingContourSteps(Rendered(box), 1, scene, cv::Mat(), 0.015);
+  EXPECT_EQ(standing.seen, 76);  // every outline pixel, the table 4 cm behind all round
+  EXPECT_EQ(standing.stepping_back, 76);
+  cv::Mat half;  // sampled every 2nd pixel, the same
+  cv::resize(Rendered(box), half, cv::Size(40, 30), 0.0, 0.0, cv::INTER_NEAREST);
+  EXPECT_DOUBLE_EQ(OccludingContourSteps(half, 2, scene, cv::Mat(), 0.015).SteppingBack(), 1.0);
+  // A pose 2 pixels off still finds the step within 3 samples beyond its outline, on its three sides on the face.
+  const OccludingContour off = OccludingContourSteps(Rendered(box + cv::Point(2, 0)), 1, scene, cv::Mat(), 0.015);
+  EXPECT_EQ(off.seen, 76);
+  EXPECT_EQ(off.stepping_back, 76 - 22);  // the right column and the 2 pixels beside it lie on the table
+  // A smaller box laid on the face: the face goes on beyond its outline.
+  const OccludingContour laid = OccludingContourSteps(Rendered({25, 25, 10, 10}), 1, scene, cv::Mat(), 0.015);
+  EXPECT_EQ(laid.seen, 36);
+  EXPECT_EQ(laid.stepping_back, 0);
+  // The box posed on the table beside the real one, at the table's depth: the table on both sides of its outline,
+  // but where the real box lies beyond, the scene steps nearer, not back.
+  cv::Mat on_table = cv::Mat::zeros(60, 80, CV_32FC1);
+  on_table(cv::Rect(41, 20, 20, 20)).setTo(1.0F);
+  const OccludingContour beside = OccludingContourSteps(on_table, 1, scene, cv::Mat(), 0.015);
+  EXPECT_EQ(beside.seen, 76);
+  EXPECT_EQ(beside.stepping_back, 0);
+  // Missing depth beyond the outline (the sensor's shadow at an occluding edge) counts as stepping back.
+  cv::Mat shadowed = scene.clone();
+  shadowed(cv::Rect(40, 20, 2, 20)).setTo(0.0F);
+  EXPECT_EQ(OccludingContourSteps(Rendered(box), 1, shadowed, cv::Mat(), 0.015).stepping_back, 76);
+  OccludingContourOptions no_gap;
+  no_gap.gap = 0;
+  EXPECT_THROW(OccludingContourSteps(Rendered(box), 1, scene, cv::Mat(), 0.015, no_gap), InputError);
+  EXPECT_THROW(OccludingContourSteps(Rendered(box), 0, scene, cv::Mat(), 0.015), InputError);
+  EXPECT_THROW(OccludingContourSteps(Rendered(box), 1, scene, cv::Mat(30, 40, CV_32FC3), 0.015), InputError);
+}
+
+// The camera of the 80 x 60 test images: 100 pixels focal length, centred.
+PinholeCamera TestCamera() {
+  PinholeCamera camera;
+  camera.fx = camera.fy = 100.0;
+  camera.cx = 39.5;
+  camera.cy = 29.5;
+  camera.width = 80;
+  camera.height = 60;
+  return camera;
+}
+
+TEST(OccludingContourSteps, CountsACreaseWhereTheSurfaceTurnsWithoutAStep) {
+  // The box's face stands on a table that comes towards the camera below it, 1 cm per pixel (1 cm at 1 m): no
+  // depth step along the bottom edge, but the table turns 45 degrees away from the face's plane.
+  const cv::Rect box(20, 20, 20, 20);
+  cv::Mat scene = TableWithBox(box);
+  for (int v = 40; v < scene.rows; ++v) scene.row(v).setTo(0.96F - 0.01F * static_cast<float>(v - 39));
+  const cv::Mat normals = DepthNormals(scene, TestCamera(), 2, 0.03);
+  const OccludingContour standing = OccludingContourSteps(Rendered(box), 1, scene, normals, 0.015);
+  EXPECT_EQ(standing.seen, 76);
+  EXPECT_EQ(standing.stepping_back, 76 - 20);  // all but the bottom row step back
+  // The bottom row's crease is judged where the face's normal 3 samples inside is defined (2 pixels from its
+  // sides): 16 of its 20 pixels.
+  EXPECT_EQ(standing.creased, 16);
+  EXPECT_EQ(OccludingContourSteps(Rendered(box), 1, scene, cv::Mat(), 0.015).creased, 0);  // without normals
+  // A smaller box laid on the face: the face goes on, flat, beyond its outline.
+  const OccludingContour laid = OccludingContourSteps(Rendered({25, 25, 10, 10}), 1, scene, normals, 0.015);
+  EXPECT_EQ(laid.seen, 36);
+  EXPECT_EQ(laid.stepping_back + laid.creased, 0);
+}
+
+TEST(DepthNormals, FaceTheCameraOnPlanesAndAreZeroAcrossSteps) {
+  PinholeCamera camera = TestCamera();
+  const cv::Mat scene = TableWithBox({20, 20, 20, 20});
+  const cv::Mat normals = DepthNormals(scene, camera, 2, 0.01);
+  // The table and the box face are fronto-parallel: (0, 0, -1), towards the camera.
+  for (const cv::Point& p : {cv::Point(30, 30), cv::Point(10, 10), cv::Point(60, 50)}) {
+    EXPECT_NEAR(normals.at<cv::Vec3f>(p)[2], -1.0F, 1e-5F) << p;
+  }
+  EXPECT_EQ(normals.at<cv::Vec3f>(30, 21), cv::Vec3f()) << "2 pixels reach across the box's left edge";
+  EXPECT_EQ(normals.at<cv::Vec3f>(0, 0), cv::Vec3f()) << "no neighbours beyond the image";
+  // A plane tilted about the vertical axis by 45 degrees: z grows by as much as x does.
+  cv::Mat tilted(60, 80, CV_32FC1);
+  for (int v = 0; v < tilted.rows; ++v) {
+    for (int u = 0; u < tilted.cols; ++u) {
+      // On the plane z = 1 + x: along the ray (u - cx) / fx, z = 1 / (1 - (u - cx) / fx).
+      tilted.at<float>(v, u) = static_cast<float>(1.0 / (1.0 - (u - camera.cx) / camera.fx));
+    }
+  }
+  const cv::Vec3f n = DepthNormals(tilted, camera, 2, 0.05).at<cv::Vec3f>(30, 40);
+  EXPECT_NEAR(n[0], std::sqrt(0.5F), 1e-3F);
+  EXPECT_NEAR(n[2], -std::sqrt(0.5F), 1e-3F);
+  EXPECT_THROW(DepthNormals(scene, camera, 0, 0.01), InputError);
+  camera.width = 40;
+  EXPECT_THROW(DepthNormals(scene, camera, 2, 0.01), InputError);
+}
+
 TEST(SurfaceContinuation, TakesACreaseAsAnEndAndLeavesOutCurvesAndHiddenOutline) {
   // The box's face stands on a table that comes towards the camera below it: no depth step at the contact, but the
   // table turns away from the face's plane (2 mm per pixel).
