@@ -39,7 +39,9 @@ struct Detection {
   double free_space_violation = 0.0;  ///< ... the share where the scene is seen far behind it; ...
   double occluding_contour = 0.0;     ///< ... the share of the seen outline where the scene steps back behind it, ...
   double creased_contour = 0.0;       ///< ... and where, not stepping back, the scene's surface turns
-  bool tracked = false;               ///< found from a prior (the previous frame's pose), without RANSAC
+  /// With the learned acceptance: its probability that the pose is right (-1: not computed).
+  double acceptance = -1.0;
+  bool tracked = false;  ///< found from a prior (the previous frame's pose), without RANSAC
   /// Frames it has been followed since a search of its model last found it (0: a search found it in this frame);
   /// TrackingOptions::confirm_every.
   int frames_followed = 0;

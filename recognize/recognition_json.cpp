@@ -8,27 +8,29 @@ namespace ecv {
 namespace {
 
 nlohmann::json DetectionToJson(const Detection& d) {
-  return {{"model", d.model},
-          {"score", d.score},
-          {"camera_from_object", PoseToJson(d.camera_from_object)},
-          {"inlier_fraction", d.inlier_fraction},
-          {"fit_error", d.fit_error_m},
-          {"view", d.view},
-          {"depth_agreement", d.depth_agreement},
-          {"color_agreement", d.color_agreement},
-          {"visible_fraction", d.visible_fraction},
-          {"surface_error", d.surface_error_m},
-          {"contour_agreement", d.contour_agreement},
-          {"continuation", d.continuation},
-          {"edge_agreement", d.edge_agreement},
-          {"edge_pixels", d.edge_pixels},
-          {"explained_surface", d.explained_surface},
-          {"free_space_violation", d.free_space_violation},
-          {"occluding_contour", d.occluding_contour},
-          {"creased_contour", d.creased_contour},
-          {"tracked", d.tracked},
-          {"confirmed", d.confirmed},
-          {"hypothesis", HypothesisSourceName(d.hypothesis_source)}};
+  nlohmann::json json = {{"model", d.model},
+                         {"score", d.score},
+                         {"camera_from_object", PoseToJson(d.camera_from_object)},
+                         {"inlier_fraction", d.inlier_fraction},
+                         {"fit_error", d.fit_error_m},
+                         {"view", d.view},
+                         {"depth_agreement", d.depth_agreement},
+                         {"color_agreement", d.color_agreement},
+                         {"visible_fraction", d.visible_fraction},
+                         {"surface_error", d.surface_error_m},
+                         {"contour_agreement", d.contour_agreement},
+                         {"continuation", d.continuation},
+                         {"edge_agreement", d.edge_agreement},
+                         {"edge_pixels", d.edge_pixels},
+                         {"explained_surface", d.explained_surface},
+                         {"free_space_violation", d.free_space_violation},
+                         {"occluding_contour", d.occluding_contour},
+                         {"creased_contour", d.creased_contour},
+                         {"tracked", d.tracked},
+                         {"confirmed", d.confirmed},
+                         {"hypothesis", HypothesisSourceName(d.hypothesis_source)}};
+  if (d.acceptance >= 0.0) json["acceptance"] = d.acceptance;
+  return json;
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include "core/timing.h"
 #include "ecv/descriptor.h"
 #include "modeldb/model_builder.h"
+#include "recognize/acceptance.h"
 #include "recognize/detection_overlay.h"
 #include "recognize/model_search.h"
 #include "recognize/scene.h"
@@ -82,7 +83,10 @@ RendererOptions VerificationRenderer(const RecognizerOptions& options) {
 class Recognizer::Impl {
  public:
   Impl(const ModelLibrary& library, const RecognizerOptions& options)
-      : library_(library), options_(options), renderer_(VerificationRenderer(options)) {
+      : library_(library),
+        options_(options),
+        learned_(options.acceptance == Acceptance::kLearned ? &AcceptanceModel::Learned() : nullptr),
+        renderer_(VerificationRenderer(options)) {
     if (library.models().empty()) ThrowInputError("model library", "models", "at least one model", "none");
     options_.match.k = 1;
     const std::vector<LibraryModel>& library_models = library_.models();
@@ -202,8 +206,9 @@ class Recognizer::Impl {
 
  private:
   bool Accepted(const Detection& detection) const {
-    return detection.score >= options_.verify.min_score &&
-           detection.visible_fraction >= options_.verify.min_visible_fraction;
+    if (detection.visible_fraction < options_.verify.min_visible_fraction) return false;
+    return options_.acceptance == Acceptance::kLearned ? detection.acceptance >= learned_->threshold()
+                                                       : detection.score >= options_.verify.min_score;
   }
 
   // Accepted, the verdict kept in `model` with keep_judged.
@@ -484,6 +489,7 @@ class Recognizer::Impl {
                       options_.verify.plane_patch)) {
       detection.score = verified.search_score = 0.0;
     }
+    if (learned_ != nullptr) detection.acceptance = learned_->Probability(detection);
     verified.surface = std::move(evidence.surface);
     verified.depth = rendered.depth;
     return verified;
@@ -518,6 +524,7 @@ class Recognizer::Impl {
 
   const ModelLibrary& library_;
   RecognizerOptions options_;
+  const AcceptanceModel* learned_;  // with Acceptance::kLearned, else null
   Renderer renderer_;
   std::mutex render_mutex_;               // Verify runs on the model workers
   std::vector<LoadedModel> models_;       // in the library's order

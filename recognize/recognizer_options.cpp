@@ -45,6 +45,17 @@ HypothesisSource ParseHypothesisSource(const std::string& name, const std::strin
   ThrowInputError(what, "hypotheses", "context, ppf or both", "'" + name + "'");
 }
 
+const char* AcceptanceName(Acceptance acceptance) {
+  return acceptance == Acceptance::kLearned ? "learned" : "hand";
+}
+
+Acceptance ParseAcceptance(const std::string& name, const std::string& what) {
+  for (const Acceptance acceptance : {Acceptance::kHandSet, Acceptance::kLearned}) {
+    if (name == AcceptanceName(acceptance)) return acceptance;
+  }
+  ThrowInputError(what, "acceptance", "hand or learned", "'" + name + "'");
+}
+
 void TwinOptions::Check() const {
   const auto require = [](bool ok, const char* field, const char* expected) {
     if (!ok) ThrowInputError("recognizer options", field, expected);

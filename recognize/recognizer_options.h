@@ -69,6 +69,16 @@ const char* HypothesisSourceName(HypothesisSource source);
 /// The source called `name`; throws InputError naming `what` otherwise.
 HypothesisSource ParseHypothesisSource(const std::string& name, const std::string& what);
 
+/// How a verified pose is accepted as a detection: by the hand-set rule (its score at least verify.min_score), or by
+/// the learned model's probability that it is right (AcceptanceModel::Learned, at its threshold); both also ask
+/// for verify.min_visible_fraction.
+enum class Acceptance { kHandSet, kLearned };
+
+/// "hand" or "learned".
+const char* AcceptanceName(Acceptance acceptance);
+/// The acceptance called `name`; throws InputError naming `what` otherwise.
+Acceptance ParseAcceptance(const std::string& name, const std::string& what);
+
 /// Shape-driven hypotheses: point pair features (registration/ppf.h) voted on the scene's depth samples (at
 /// dense_stride_px), the best pose clusters refined by ICP and verified as the context's poses are.
 struct PointPairOptions {
@@ -118,6 +128,7 @@ struct RecognizerOptions {
   VerifyOptions verify;
   TrackingOptions tracking;
   PointPairOptions point_pairs;
+  Acceptance acceptance = Acceptance::kHandSet;
 
   /// Views per model tried with RANSAC, the best ranked first.
   int views_per_model = 10;

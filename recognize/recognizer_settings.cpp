@@ -144,6 +144,14 @@ void AddSearchSettings(std::vector<Setting>* table) {
       [](RecognizerSettings& s, const std::string& name) {
         s.options.point_pairs.source = ParseHypothesisSource(name, "hypotheses");
       }));
+  table->push_back(Choice(
+      "acceptance", {AcceptanceName(Acceptance::kHandSet), AcceptanceName(Acceptance::kLearned)},
+      "How a verified pose becomes a detection: hand (its score at least --min-score) or learned (a model of\n"
+      "every evidence term, trained on generated scenes, says it is right; the score is still reported)",
+      [](const RecognizerSettings& s) { return AcceptanceName(s.options.acceptance); },
+      [](RecognizerSettings& s, const std::string& name) {
+        s.options.acceptance = ParseAcceptance(name, "acceptance");
+      }));
   table->push_back(Count(
       "seed", 0, kNoMax, "Random seed", [](auto& s) -> auto& { return s.options.ransac.seed; }));
   table->push_back(Count(

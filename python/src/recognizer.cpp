@@ -228,6 +228,8 @@ void BindDetection(py::module_& m) {
       .def_readonly("free_space_violation", &Detection::free_space_violation)
       .def_readonly("occluding_contour", &Detection::occluding_contour)
       .def_readonly("creased_contour", &Detection::creased_contour)
+      .def_readonly("acceptance", &Detection::acceptance,
+                    "the learned acceptance's probability that it is right (-1: not used)")
       .def_readonly("tracked", &Detection::tracked)
       .def_readonly("frames_followed", &Detection::frames_followed)
       .def_readonly("confirmed", &Detection::confirmed)

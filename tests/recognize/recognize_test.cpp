@@ -19,6 +19,7 @@
 #include "io/pose_io.h"
 #include "modeldb/model_library.h"
 #include "modeldb/sql.h"
+#include "recognize/acceptance.h"
 #include "recognize/evaluation.h"
 #include "recognize/recognition_json.h"
 #include "recognize/recognizer.h"
@@ -129,6 +130,26 @@ TEST_F(RecognizeEndToEnd, FindsTheObjectsOfTheDemoFrameWithinTenthOfTheirDiamete
   const test::CommandResult eval = test::RunCli("eval --detections " + json + " --db " + library_ + " " + Frame());
   ASSERT_EQ(eval.exit_code, 0) << eval.output;
   EXPECT_NE(eval.output.find("| 003_cracker_box | yes |"), std::string::npos) << eval.output;
+}
+
+// The learned acceptance (`--acceptance learned`) decides by its probability, which the detections carry: the demo
+// frame's three objects are found at their true poses by it too, nothing else; the hand-set rule computes none.
+TEST_F(RecognizeEndToEnd, TheLearnedAcceptanceFindsTheDemoFramesObjects) {
+  const LoadedFrame frame = LoadYcbvFrame(Frame());
+  const ModelLibrary library = Library();
+  RecognizerOptions options;
+  options.acceptance = Acceptance::kLearned;
+  const std::vector<Detection> detections = Recognizer(library, options).Recognize(frame.rgbd).detections;
+  for (const Detection& detection : detections) {
+    EXPECT_GE(detection.acceptance, AcceptanceModel::Learned().threshold()) << detection.model;
+  }
+  const FrameEvaluation evaluation = EvaluateFrame("0001/000001", detections, frame.ground_truth, EvalModels(library));
+  EXPECT_EQ(evaluation.false_positives, 0);
+  for (const ObjectEvaluation& object : evaluation.objects) EXPECT_TRUE(object.correct) << object.model;
+  EXPECT_EQ(evaluation.objects.size(), 3U);
+  for (const Detection& detection : Recognizer(library, RecognizerOptions()).Recognize(frame.rgbd).detections) {
+    EXPECT_EQ(detection.acceptance, -1.0) << detection.model;
+  }
 }
 
 // The speed options: exact matching over 7-bit descriptors (plain loop or VNNI, the same matches) and view ranking
