@@ -48,6 +48,7 @@ struct Run {
   std::vector<FrameEvaluation> evaluations;        // per frame
   std::vector<std::vector<Detection>> detections;  // per frame
   std::vector<std::vector<JudgedPose>> judged;     // per frame, with RecognizerOptions::keep_judged
+  std::vector<std::vector<Detection>> verified;    // per frame, with RecognizerOptions::keep_verified
   std::vector<double> ms;                          // per frame
   std::vector<int> frame_index;                    // into the set's frames
 };
@@ -76,7 +77,7 @@ Run RunRecognizer(const ModelLibrary& library, const RecognizerOptions& options,
   const bool track = stream_options.track;
   Recognizer recognizer(library, options);
   RecognitionStream stream(recognizer, stream_options);
-  Run run{label, {}, {}, {}, {}, {}};
+  Run run{label, {}, {}, {}, {}, {}, {}};
   for (size_t i = 0; i < frames.size(); ++i) {
     if (track && frames[i].stream.empty()) continue;  // tracking runs over the streams only
     if (!track || i == 0 || frames[i].stream != frames[i - 1].stream) stream.Reset();
@@ -84,6 +85,7 @@ Run RunRecognizer(const ModelLibrary& library, const RecognizerOptions& options,
     run.evaluations.push_back(EvaluateFrame(frames[i].name, result.detections, frames[i].frame.ground_truth, models));
     run.detections.push_back(result.detections);
     run.judged.push_back(result.judged);
+    run.verified.push_back(result.verified);
     run.ms.push_back(result.timings_ms.at("total"));
     run.frame_index.push_back(static_cast<int>(i));
     Counts counts;
@@ -303,6 +305,7 @@ struct Settings {
   RecognizerSettings recognizer;  // every run: the settings table's flags
   std::string detections;         // JSON Lines of every run's detections, when given
   std::string judged;             // JSON Lines of every pose the acceptance judged, labelled, when given
+  std::string verified;           // JSON Lines of each present object's verified poses, counted, when given
 };
 
 // One line per frame of `run`: its set, condition and name, the detections with their verification terms, and
@@ -381,6 +384,42 @@ void AppendJudged(const std::string& path, const Run& run, const std::vector<Ben
   }
 }
 
+// One line per object of each frame of `run` (a model of the library in the frame's ground truth): how many of its
+// poses were verified and how many of them were right, the best score of each kind, and whether it was found. An
+// object missed with a right pose verified was lost in the choice among poses; one without, by the hypotheses.
+void AppendVerified(const std::string& path, const Run& run, const std::vector<BenchFrame>& frames,
+                    const std::vector<EvalModel>& models) {
+  std::ofstream out(path, std::ios::app);
+  if (!out) ThrowInputError(path, "--verified", "a file that can be written");
+  for (size_t k = 0; k < run.verified.size(); ++k) {
+    const BenchFrame& frame = frames[static_cast<size_t>(run.frame_index[k])];
+    for (const ObjectEvaluation& object : run.evaluations[k].objects) {
+      int verified = 0, right = 0;
+      double best_right = 0.0, best_wrong = 0.0;
+      for (const Detection& pose : run.verified[k]) {
+        if (pose.model != object.model) continue;
+        ++verified;
+        const bool is_right = ErrorOverDiameter(pose, frame.frame, models) < 0.1;
+        right += is_right ? 1 : 0;
+        double& best = is_right ? best_right : best_wrong;
+        best = std::max(best, pose.score);
+      }
+      out << nlohmann::json{{"run", run.label},
+                            {"set", frame.set},
+                            {"condition", frame.condition},
+                            {"frame", frame.name},
+                            {"model", object.model},
+                            {"found", object.correct},
+                            {"verified", verified},
+                            {"right", right},
+                            {"best_right_score", best_right},
+                            {"best_wrong_score", best_wrong}}
+                 .dump()
+          << '\n';
+    }
+  }
+}
+
 int Main(int argc, char** argv) {
   CLI::App app("Recognition on the generalisation set: rendered scenes, composites of real frames, cast light");
   Settings s;
@@ -405,6 +444,9 @@ int Main(int argc, char** argv) {
   app.add_option("--judged", s.judged,
                  "JSON Lines file every pose the acceptance judged is appended to, one per line, with its evidence, "
                  "the verdict and whether it was right (ADD, ADD-S for symmetric models, < 0.1 x diameter)");
+  app.add_option("--verified", s.verified,
+                 "JSON Lines file each present object's verified poses are counted into, one object of a frame per "
+                 "line: how many, how many right, the best score of each, found or not");
   s.recognizer.options.threads = 2;  // the benchmark machine's cores
   AddSettingFlags(app, &s.recognizer, {"hypotheses", "track", "search-beside"},
                   "Settings of every run (as `ecvpose recognize` takes them)");
@@ -474,6 +516,7 @@ int Main(int argc, char** argv) {
   const auto add_run = [&](Run run) {
     if (!s.detections.empty()) AppendDetections(s.detections, run, frames);
     if (!s.judged.empty()) AppendJudged(s.judged, run, frames, models, grey);
+    if (!s.verified.empty()) AppendVerified(s.verified, run, frames, models);
     runs.push_back(std::move(run));
     if (runs.size() == 1 && !s.figures.empty())
       WriteFigures(library, runs.front(), frames, s.figures, tag, s.figure_format);
@@ -483,6 +526,7 @@ int Main(int argc, char** argv) {
     for (const uint64_t seed : s.seeds) {
       RecognizerOptions options = s.recognizer.options;
       options.keep_judged = !s.judged.empty();
+      options.keep_verified = !s.verified.empty();
       options.point_pairs.source = ParseHypothesisSource(source, "--hypotheses");
       options.ransac.seed = seed;
       const std::string label = source + ", seed " + std::to_string(seed);

@@ -73,6 +73,9 @@ struct RecognitionResult {
   /// With RecognizerOptions::keep_judged: each model's best pose for each instance searched for, and each prior
   /// followed, before overlaps are suppressed; per model in library order.
   std::vector<JudgedPose> judged;
+  /// With RecognizerOptions::keep_verified: every pose verified in the frame (RANSAC's, refined, turned, point pairs',
+  /// followed priors'), as verification scored it, by model in library order, then best score first.
+  std::vector<Detection> verified;
 };
 
 /// One library view as view ranking saw it in a frame.

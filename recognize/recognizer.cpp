@@ -1,6 +1,7 @@
 #include "recognize/recognizer.h"
 
 #include <algorithm>
+#include <map>
 #include <mutex>
 #include <numeric>
 #include <optional>
@@ -145,6 +146,7 @@ class Recognizer::Impl {
     RecognitionResult result;
     StageTimes times;
     Scene scene = PrepareScene(frame, options_);
+    if (options_.keep_verified) scene.verified_log = std::make_unique<Scene::VerifiedLog>();
     std::vector<ModelInFrame> models = AssignPriors(priors, model_names_, options_.tracking);
     if (!priors.empty()) {
       const Clock::time_point stage = Clock::now();
@@ -185,6 +187,7 @@ class Recognizer::Impl {
     }
     const Clock::time_point stage = Clock::now();
     result.detections = SuppressOverlaps(frame.depth.size(), std::move(candidates));
+    if (scene.verified_log) result.verified = SortedByModel(std::move(scene.verified_log->poses));
     times.Add(Stage::kVerify, MillisecondsSince(stage));
     times.Add(Stage::kTotal, MillisecondsSince(start));
     result.timings_ms = times.Map();
@@ -433,6 +436,19 @@ class Recognizer::Impl {
     return best;
   }
 
+  // `poses` by model in library order, then best score first (ties by pose), whatever order the workers added them in.
+  std::vector<Detection> SortedByModel(std::vector<Detection> poses) const {
+    std::map<std::string, size_t> order;
+    for (size_t m = 0; m < model_names_.size(); ++m) order[model_names_[m]] = m;
+    std::sort(poses.begin(), poses.end(), [&](const Detection& a, const Detection& b) {
+      if (a.model != b.model) return order[a.model] < order[b.model];
+      if (a.score != b.score) return a.score > b.score;
+      const Eigen::Vector3d ta = a.camera_from_object.translation(), tb = b.camera_from_object.translation();
+      return std::lexicographical_compare(ta.data(), ta.data() + 3, tb.data(), tb.data() + 3);
+    });
+    return poses;
+  }
+
   // The detections, best first, without those whose rendered surface lies mostly (max_overlap) on scene pixels
   // that a better detection of another model already explains: one surface, one object.
   std::vector<Detection> SuppressOverlaps(const cv::Size& image_size, std::vector<VerifiedPose> candidates) const {
@@ -490,6 +506,10 @@ class Recognizer::Impl {
       detection.score = verified.search_score = 0.0;
     }
     if (learned_ != nullptr) detection.acceptance = learned_->Probability(detection);
+    if (scene.verified_log) {
+      const std::lock_guard<std::mutex> lock(scene.verified_log->mutex);
+      scene.verified_log->poses.push_back(detection);
+    }
     verified.surface = std::move(evidence.surface);
     verified.depth = rendered.depth;
     return verified;

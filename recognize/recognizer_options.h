@@ -176,6 +176,8 @@ struct RecognizerOptions {
   /// Keep every pose the acceptance judged in RecognitionResult::judged, accepted or not: the records an acceptance
   /// is learned from.
   bool keep_judged = false;
+  /// Keep every pose verified in RecognitionResult::verified: where a search's hypotheses were right and where not.
+  bool keep_verified = false;
 
   /// The paper's RANSAC with adaptive stopping, poses ranked by agreeing correspondences, at most 10 000 samples
   /// per view, and a sample counted only when 1 % of the correspondences (at least 1) agree with it.

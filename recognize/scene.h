@@ -6,6 +6,7 @@
 #include <array>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,7 @@
 #include "ecv/matching.h"
 #include "ecv/primitives.h"
 #include "modeldb/model_record.h"
+#include "recognize/detection.h"
 #include "recognize/recognizer_options.h"
 #include "recognize/verification.h"
 #include "registration/icp.h"
@@ -69,6 +71,12 @@ struct Scene {
   VerificationFrame verification;
   OrganizedScene organized;  ///< the depth samples with normals, for projective ICP and point pair hypotheses
   SceneVisibility visibility;
+  /// With RecognizerOptions::keep_verified: every verified pose, from the model workers.
+  struct VerifiedLog {
+    std::mutex mutex;
+    std::vector<Detection> poses;
+  };
+  std::unique_ptr<VerifiedLog> verified_log;
 };
 
 /// What every model needs of `frame` (which must outlive the scene): dense points, verification images, visibility.

@@ -290,6 +290,7 @@ TEST_F(RecognizeEndToEnd, SameSeedSameDetections) {
 
 // keep_judged keeps every pose the acceptance judged: on the demo frame each model's best pose, the three accepted
 // ones being the detections; with a bar no pose reaches, the same poses, all rejected, and no detections.
+// keep_verified keeps every pose verified.
 TEST_F(RecognizeEndToEnd, KeepsEveryJudgedPoseWithItsVerdict) {
   const ModelLibrary library = Library();
   const LoadedFrame frame = LoadYcbvFrame(Frame());
@@ -308,6 +309,22 @@ TEST_F(RecognizeEndToEnd, KeepsEveryJudgedPoseWithItsVerdict) {
   EXPECT_EQ(accepted, detected);
   EXPECT_EQ(RecognitionToJson(found)["judged"].size(), found.judged.size());
   EXPECT_FALSE(Recognizer(library, RecognizerOptions()).Recognize(frame.rgbd).judged.size() > 0) << "kept unasked";
+
+  // keep_verified: every pose verified on the way, each judged pose among them, by model then score.
+  options.keep_verified = true;
+  const RecognitionResult traced = Recognizer(library, options).Recognize(frame.rgbd);
+  EXPECT_GT(traced.verified.size(), traced.judged.size());
+  for (const JudgedPose& pose : traced.judged) {
+    EXPECT_TRUE(std::any_of(traced.verified.begin(), traced.verified.end(), [&](const Detection& verified) {
+      return verified.model == pose.detection.model && verified.score == pose.detection.score;
+    })) << pose.detection.model;
+  }
+  for (size_t i = 1; i < traced.verified.size(); ++i) {
+    if (traced.verified[i].model == traced.verified[i - 1].model) {
+      EXPECT_LE(traced.verified[i].score, traced.verified[i - 1].score);
+    }
+  }
+  options.keep_verified = false;
 
   options.verify.min_score = 0.99;
   const RecognitionResult none = Recognizer(library, options).Recognize(frame.rgbd);

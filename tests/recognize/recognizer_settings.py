@@ -35,7 +35,7 @@ OWN_FLAGS = {
                         "--frame-step", "--ppf-sampling", "--ppf-scene-distance", "--min-inlier-fraction"},
     "generalisation_bench": {"--help", "--db", "--data", "--seeds", "--rendered", "--composites", "--split",
                              "--cast-step", "--figures", "--figure-format", "--results",
-                             "--detections", "--judged"},
+                             "--detections", "--judged", "--verified"},
 }
 # Settings a front end does not take, and why: the benches run frames in a fixed order, and a search beside the
 # tracking would make their detections depend on the machine's speed.
