@@ -2,12 +2,14 @@
 """How well each term of a pose's evidence separates right poses from wrong ones, from the poses the acceptance
 judged (`generalisation_bench --judged FILE`, `recognize` with keep_judged).
 
-  bench/judged_evidence.py JUDGED.jsonl [--by set|hypothesis|grey] [--model MODEL.json] [--made-by TEXT] [--results FILE]
+  bench/judged_evidence.py JUDGED.jsonl [--by set|hypothesis|grey] [--model MODEL.json] [--verified VERIFIED.jsonl]
+                           [--made-by TEXT] [--results FILE]
 
 Prints, per term, the area under the ROC curve (AUC: the chance that a right pose has the higher value; 0.5 = no
 separation, below 0.5 = lower is right) over every judged pose, and per group; the counts of right and wrong poses and
 how the acceptance decided them; with --model (scripts/train_acceptance's), how that model would decide the same
-poses. --made-by quotes how JUDGED was made in the report. With --results, the report replaces its section of that
+poses; with --verified (`generalisation_bench --verified`, the same run), why the objects missed were missed: no right
+pose verified at all, or one verified and beaten or below the bar. --made-by quotes how JUDGED was made in the report. With --results, the report replaces its section of that
 file (bench/RESULTS.md).
 """
 
@@ -102,11 +104,33 @@ def verdict_table(records, verdicts, model_path):
     return "\n".join(lines) + "\n"
 
 
+def missed_table(path):
+    """Per set: objects, found, and the missed ones by cause, from a --verified file."""
+    try:
+        with open(path) as lines:
+            objects = [json.loads(line) for line in lines if line.strip()]
+    except (OSError, ValueError) as error:
+        sys.exit("judged_evidence: %s: %s" % (path, error))
+    sets = ["all"] + sorted({o["set"] for o in objects})
+    lines = ["| set | objects | found | missed: no right pose verified | missed: a right one verified, a wrong one "
+             "scored higher | missed: a right one verified, best of its model, below the bar |",
+             "|---|---:|---:|---:|---:|---:|"]
+    for name in sets:
+        group = [o for o in objects if name == "all" or o["set"] == name]
+        missed = [o for o in group if not o["found"]]
+        none = sum(1 for o in missed if o["right"] == 0)
+        beaten = sum(1 for o in missed if o["right"] > 0 and o["best_wrong_score"] > o["best_right_score"])
+        lines.append("| %s | %d | %d | %d | %d | %d |" % (name, len(group), len(group) - len(missed), none, beaten,
+                                                       len(missed) - none - beaten))
+    return "\n".join(lines) + "\n"
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("judged")
     parser.add_argument("--by", choices=["set", "hypothesis", "grey"], default="set")
     parser.add_argument("--model", help="a model of scripts/train_acceptance to decide the same poses")
+    parser.add_argument("--verified", help="generalisation_bench --verified file of the same run")
     parser.add_argument("--made-by", help="the command that wrote JUDGED, quoted in the report")
     parser.add_argument("--results", help="markdown file whose section this report replaces")
     args = parser.parse_args()
@@ -128,6 +152,9 @@ def main():
         lines += ["The same poses decided by the hand-set rule and by the model (offline: under `--hypotheses both` "
                   "point pairs run for the models the context's pose was rejected for, so a run with the model "
                   "judges slightly different poses):", "", verdict_table(records, verdicts, args.model)]
+    if args.verified:
+        lines += ["Why the objects missed were missed (`%s`: every pose verified for each object present, right "
+                  "when ADD (ADD-S) < 0.1 x diameter):" % args.verified, "", missed_table(args.verified)]
     if args.results:
         report(args.results, "Evidence of judged poses (judged_evidence.py)", lines)
     else:

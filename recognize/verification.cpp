@@ -86,6 +86,9 @@ PoseEvidence MeasurePose(const RenderedPose& rendered, const VerificationFrame& 
       rendered.depth.cols != (frame.depth.cols + stride - 1) / stride) {
     ThrowInputError("verification", "rendered pose", "CV_8UC3 colour and CV_32FC1 depth of the frame's size / stride");
   }
+  if (frame.normals.size() != rendered.depth.size()) {
+    ThrowInputError("verification", "frame", "normals at the stride (MakeVerificationFrame)");
+  }
   cv::Mat model_color;
   if (options.color_blur_px > 0.0) {
     cv::GaussianBlur(rendered.color, model_color, cv::Size(0, 0), options.color_blur_px / stride);
