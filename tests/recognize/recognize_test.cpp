@@ -50,6 +50,15 @@ class RecognizeEndToEnd : public test::DemoLibrarySuite {
     return ModelLibrary::Load(library_, load);
   }
 
+  // Options that verify a prior at its pose as it is (no ICP) and report it whatever its score.
+  static RecognizerOptions VerifiedAsItIs() {
+    RecognizerOptions options;
+    options.refine = false;
+    options.verify.min_score = 0.0;
+    options.verify.min_visible_fraction = 0.0;
+    return options;
+  }
+
   // A library of models/meshes as the suite's, built with the feature settings `settings_json` into `name`.sqlite.
   static ModelLibrary LibraryWithSettings(const std::string& name, const std::string& settings_json) {
     const std::string settings = directory_->File(name + ".json");
@@ -576,10 +585,7 @@ TEST_F(RecognizeEndToEnd, APoseAFewMillimetresOffTheSurfaceScoresZeroThroughItsR
   const LoadedFrame frame = LoadYcbvFrame(Frame());
   const GroundTruth* truth = TruthOf(frame, "003_cracker_box");
   ASSERT_NE(truth, nullptr);
-  RecognizerOptions options;
-  options.refine = false;  // verified at the prior's pose as it is
-  options.verify.min_score = 0.0;
-  options.verify.min_visible_fraction = 0.0;
+  RecognizerOptions options = VerifiedAsItIs();
   auto verify = [&](const RecognizerOptions& settings, const Eigen::Isometry3d& pose) {
     return test::VerifyPrior(library, settings, frame.rgbd, "003_cracker_box", pose);
   };
@@ -605,10 +611,7 @@ TEST_F(RecognizeEndToEnd, TheGeometricEvidenceFallsOffTheTruePose) {
   const LoadedFrame frame = LoadYcbvFrame(Frame());
   const GroundTruth* truth = TruthOf(frame, "003_cracker_box");
   ASSERT_NE(truth, nullptr);
-  RecognizerOptions options;
-  options.refine = false;  // verified at the prior's pose as it is
-  options.verify.min_score = 0.0;
-  options.verify.min_visible_fraction = 0.0;
+  RecognizerOptions options = VerifiedAsItIs();
   auto verify = [&](const Eigen::Isometry3d& pose) {
     return test::VerifyPrior(library, options, frame.rgbd, "003_cracker_box", pose);
   };
