@@ -28,6 +28,7 @@
 #include "recognize/recognizer.h"
 #include "scenes/composites.h"
 #include "support/test_data.h"
+#include "support/ycbv_library.h"
 #include "verify_prior.h"
 
 namespace ecv {
@@ -35,34 +36,8 @@ namespace {
 
 constexpr int kFoundAtLeast = 6;  // of 7: all but the banana of 0002 (with the all-pairs context: the potted meat can)
 
-class YcbvLibrary : public ::testing::Test {
+class YcbvLibrary : public test::YcbvLibrarySuite {
  protected:
-  // Under ctest, the library its ycbv_library fixture built once for every test (scripts/build_ycbv_library, the same
-  // models and flags); run alone, a library of its own. Tests read it and do not change it (copy it first).
-  static void SetUpTestSuite() {
-    directory_ = new test::TemporaryDirectory();
-    if (const char* shared = std::getenv("ECV_YCBV_LIBRARY")) {
-      library_ = shared;
-      return;
-    }
-    library_ = directory_->File("ycbv.sqlite");
-    const std::string data = test::DataPath("ycbv_subset");
-    for (const auto& [name, object_from_mesh] : ReadTransformTable(data + "/derived/google16k_to_ycbv.txt")) {
-      const std::string pose = directory_->File(name + ".json");
-      WriteJsonFile(pose, {{"object_from_mesh", PoseToJson(object_from_mesh)}});
-      const test::CommandResult build =
-          test::RunCli("modeldb build " + data + "/ycb_google16k_textured/" + name + "_textured.obj --name " + name +
-                       " --object-from-mesh " + pose + " --views 40 --distance 0.9 --db " + library_);
-      ASSERT_EQ(build.exit_code, 0) << build.output;
-    }
-    const test::CommandResult banana = test::RunCli("modeldb build " + data +
-                                                    "/models/011_banana/textured_simple.obj --name 011_banana "
-                                                    "--views 40 --distance 0.9 --db " +
-                                                    library_);
-    ASSERT_EQ(banana.exit_code, 0) << banana.output;
-  }
-  static void TearDownTestSuite() { delete directory_; }
-
   static std::vector<std::string> Frames() {
     const std::string scenes = test::DataPath("ycbv_subset/Example-Scenes/");
     return {scenes + "0000/000001", scenes + "0001/000001", scenes + "0002/000001"};
@@ -83,13 +58,7 @@ class YcbvLibrary : public ::testing::Test {
     for (std::string line; std::getline(in, line);) lines.push_back(nlohmann::json::parse(line));
     return lines;
   }
-
-  static test::TemporaryDirectory* directory_;
-  static std::string library_;
 };
-
-test::TemporaryDirectory* YcbvLibrary::directory_ = nullptr;
-std::string YcbvLibrary::library_;
 
 TEST_F(YcbvLibrary, FindsTexturedObjectsOnThreeVideosWithoutFalsePositives) {
   const std::vector<nlohmann::json> lines = Recognize("run", "");
