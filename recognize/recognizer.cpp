@@ -403,9 +403,18 @@ class Recognizer::Impl {
         options_.point_pairs.remove_plane
             ? WithoutDominantPlane(OrientedScenePoints(scene.organized), options_.point_pairs.plane)
             : OrientedScenePoints(scene.organized);
+    // Points on the surface of a detection made already (the context's, a followed prior's) lead no vote.
+    std::vector<OrientedPoint> open, explained;
+    const cv::Mat taken = DetectedSurface(*models, scene.frame->depth.size());
+    for (const OrientedPoint& point : points) {
+      const Eigen::Vector2d pixel = scene.frame->camera.Project(point.position.cast<double>());
+      const int u = static_cast<int>(std::lround(pixel.x())), v = static_cast<int>(std::lround(pixel.y()));
+      const bool inside = u >= 0 && v >= 0 && u < taken.cols && v < taken.rows;
+      (inside && taken.at<uchar>(v, u) != 0 ? explained : open).push_back(point);
+    }
     std::vector<StageTimes> model_times(wanted.size());
     ParallelFor(wanted.size(), options_.threads, [&](size_t i) {
-      std::optional<VerifiedPose> best = BestPointPairPose(wanted[i], scene, points, &model_times[i]);
+      std::optional<VerifiedPose> best = BestPointPairPose(wanted[i], scene, open, explained, &model_times[i]);
       if (best && options_.twins.enabled) best = BestTwin(wanted[i], scene, std::move(*best), &model_times[i]);
       if (best && Judge(best->detection, &(*models)[wanted[i]])) {
         AddInstance(std::move(*best), options_.dense_stride_px, scene.frame->depth.size(), &(*models)[wanted[i]]);
@@ -414,12 +423,28 @@ class Recognizer::Impl {
     for (const StageTimes& model : model_times) *times += model;
   }
 
-  // The model's best point pair pose clusters among the scene's oriented `points`, each verified, refined by ICP and
-  // verified again (the better kept); the best of them.
+  // The pixels of the frame (`size`) on the rendered surface of the detections in `models`, each surface sample
+  // (every dense_stride_px-th pixel) standing for its stride's square.
+  cv::Mat DetectedSurface(const std::vector<ModelInFrame>& models, const cv::Size& size) const {
+    cv::Mat taken = cv::Mat::zeros(size, CV_8UC1);
+    const int stride = options_.dense_stride_px;
+    for (const ModelInFrame& model : models) {
+      for (const VerifiedPose& instance : model.instances) {
+        for (const cv::Point& p : instance.surface) {
+          cv::rectangle(taken, cv::Rect(p.x - stride / 2, p.y - stride / 2, stride, stride), 255, cv::FILLED);
+        }
+      }
+    }
+    return taken;
+  }
+
+  // The model's best point pair pose clusters among the scene's oriented `points` (the `explained` ones only paired
+  // with), each verified, refined by ICP and verified again (the better kept); the best of them.
   std::optional<VerifiedPose> BestPointPairPose(size_t model, const Scene& scene,
-                                                const std::vector<OrientedPoint>& points, StageTimes* times) {
+                                                const std::vector<OrientedPoint>& points,
+                                                const std::vector<OrientedPoint>& explained, StageTimes* times) {
     Clock::time_point stage = Clock::now();
-    const std::vector<PpfPose> poses = FindPpfPoses(*models_[model].point_pairs, points);
+    const std::vector<PpfPose> poses = FindPpfPoses(*models_[model].point_pairs, points, explained);
     times->Add(Stage::kPointPairs, MillisecondsSince(stage));
     const ModelSearch search = Search(model, scene, 1);
     std::optional<VerifiedPose> best;

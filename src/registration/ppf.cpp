@@ -162,6 +162,27 @@ struct Vote {
   double votes;
 };
 
+// An accumulator cell and its votes.
+struct Peak {
+  uint32_t votes;
+  size_t cell;
+};
+
+// The `k` cells of `accumulator` with the most votes (the bits `count_mask` selects), at least 3, most first and of
+// equal votes the lower cell first, in one pass.
+void BestCells(const std::vector<uint32_t>& accumulator, uint32_t count_mask, size_t k, std::vector<Peak>* peaks) {
+  peaks->clear();
+  uint32_t floor = 2;  // a cell needs more votes than this to enter
+  for (size_t c = 0; c < accumulator.size(); ++c) {
+    const uint32_t votes = accumulator[c] & count_mask;
+    if (votes <= floor) continue;
+    auto at = std::find_if(peaks->begin(), peaks->end(), [&](const Peak& p) { return p.votes < votes; });
+    peaks->insert(at, {votes, c});
+    if (peaks->size() > k) peaks->pop_back();
+    if (peaks->size() == k) floor = peaks->back().votes;
+  }
+}
+
 // Greedy clustering (Drost Sect. 3.4): poses by votes, each joining the first cluster whose leading pose is close.
 std::vector<PpfPose> ClusterPoses(std::vector<Vote> votes, double diameter_m, const PpfOptions& options) {
   std::stable_sort(votes.begin(), votes.end(), [](const Vote& a, const Vote& b) { return a.votes > b.votes; });
@@ -427,30 +448,41 @@ PpfModel::PpfModel(std::vector<OrientedPoint> points, double diameter_m, const P
   }
 }
 
-std::vector<PpfPose> FindPpfPoses(const PpfModel& model, const std::vector<OrientedPoint>& scene_points) {
+std::vector<PpfPose> FindPpfPoses(const PpfModel& model, const std::vector<OrientedPoint>& scene_points,
+                                  const std::vector<OrientedPoint>& explained) {
   const PpfOptions& options = model.options();
   const double diameter = model.diameter_m();
-  const std::vector<OrientedPoint> scene =
+  // The reference points' candidates first, then the explained points they may pair with.
+  std::vector<OrientedPoint> scene =
       SubsampleByNormals(scene_points, options.sampling * diameter, options.scene_keep_normal_deg);
+  const size_t references = scene.size();
+  if (!explained.empty()) {
+    const std::vector<OrientedPoint> others =
+        SubsampleByNormals(explained, options.sampling * diameter, options.scene_keep_normal_deg);
+    scene.insert(scene.end(), others.begin(), others.end());
+  }
   const FeatureBins bins(diameter, options);
   const CellGrid grid(scene, diameter);
   const size_t model_points = model.points().size();
   const int angle_bins = options.angle_bins;
-  // Per model point and rotation bin: the votes (low 32 bits) and the last scene pair that voted (high 32 bits), so
-  // that a pair votes once per cell; in one word, for one memory access per vote.
-  std::vector<uint64_t> accumulator(model_points * static_cast<size_t>(angle_bins));
+  // Per model point and rotation bin: the votes (low 16 bits) and the last scene pair of the reference point that
+  // voted (high 16 bits), so that a pair votes once per cell; one 32-bit word, for one memory access per vote.
+  std::vector<uint32_t> accumulator(model_points * static_cast<size_t>(angle_bins));
   std::vector<Eigen::Matrix3f> model_to_x(model_points);
   for (size_t m = 0; m < model_points; ++m) model_to_x[m] = ToXAxis(model.points()[m].normal);
   std::vector<Vote> votes;
+  std::vector<Peak> peaks;
   const float squared_diameter = static_cast<float>(diameter * diameter);
-  constexpr uint64_t kCount = 0xffffffffU;
-  for (size_t r = 0; r < scene.size(); r += static_cast<size_t>(options.scene_reference_step)) {
+  constexpr uint32_t kCount = 0xffffU;
+  for (size_t r = 0; r < references; r += static_cast<size_t>(options.scene_reference_step)) {
     const OrientedPoint& reference = scene[r];
     const Eigen::Matrix3f to_x = ToXAxis(reference.normal);
-    std::fill(accumulator.begin(), accumulator.end(), 0);
-    uint64_t pair = 0;
+    std::fill(accumulator.begin(), accumulator.end(), 0U);
+    uint32_t pair = 0;
     grid.ForNear(reference.position, [&](int i) {
-      if (static_cast<size_t>(i) == r) return;
+      // A reference point has a few thousand pairs at most (its sub-sampled neighbours within one diameter); any
+      // beyond the 16-bit stamps do not vote.
+      if (static_cast<size_t>(i) == r || pair == kCount) return;
       const OrientedPoint& other = scene[static_cast<size_t>(i)];
       if ((other.position - reference.position).squaredNorm() > squared_diameter) return;
       float positions[4];
@@ -464,31 +496,25 @@ std::vector<PpfPose> FindPpfPoses(const PpfModel& model, const std::vector<Orien
         for (const PpfModel::Entry* entry = begin; entry != end; ++entry) {
           // alpha_model - alpha_scene, wrapped to a turn, from -pi: the rotation about x between the two frames.
           const uint32_t turn = static_cast<uint16_t>(entry->alpha - alpha_scene + 32768U);
-          uint64_t& cell =
+          uint32_t& cell =
               accumulator[entry->reference * static_cast<size_t>(angle_bins) + ((turn * angle_bins) >> 16)];
-          if ((cell >> 32) != pair) cell = (pair << 32) | ((cell & kCount) + 1);
+          if ((cell >> 16) != pair) cell = (pair << 16) | ((cell & kCount) + 1U);
         }
       }
     });
     // The reference point's best cells as poses: camera_from_object = T_s^-1 R_x(alpha) T_m.
-    for (int best = 0; best < options.poses_per_reference; ++best) {
-      size_t cell = 0;
-      for (size_t c = 1; c < accumulator.size(); ++c) {
-        if ((accumulator[c] & kCount) > (accumulator[cell] & kCount)) cell = c;
-      }
-      const uint64_t peak = accumulator[cell] & kCount;
-      if (peak < 3) break;
-      const size_t m = cell / static_cast<size_t>(angle_bins);
+    BestCells(accumulator, kCount, static_cast<size_t>(options.poses_per_reference), &peaks);
+    for (const Peak& peak : peaks) {
+      const size_t m = peak.cell / static_cast<size_t>(angle_bins);
       const double alpha =
-          (static_cast<double>(cell % static_cast<size_t>(angle_bins)) + 0.5) * 2.0 * kPi / angle_bins - kPi;
+          (static_cast<double>(peak.cell % static_cast<size_t>(angle_bins)) + 0.5) * 2.0 * kPi / angle_bins - kPi;
       const Eigen::Matrix3d rotation = to_x.transpose().cast<double>() *
                                        Eigen::AngleAxisd(alpha, Eigen::Vector3d::UnitX()).toRotationMatrix() *
                                        model_to_x[m].cast<double>();
       Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
       pose.linear() = rotation;
       pose.translation() = reference.position.cast<double>() - rotation * model.points()[m].position.cast<double>();
-      votes.push_back({pose, static_cast<double>(peak)});
-      accumulator[cell] &= ~kCount;
+      votes.push_back({pose, static_cast<double>(peak.votes)});
     }
   }
   return ClusterPoses(std::move(votes), diameter, options);

@@ -141,6 +141,9 @@ struct PpfPose {
 };
 
 /// The model's best pose clusters among `scene` points (camera frame, normals towards the camera), most votes first.
-std::vector<PpfPose> FindPpfPoses(const PpfModel& model, const std::vector<OrientedPoint>& scene);
+/// `explained` points (a surface a detection already accounts for) pair with the scene's but lead no vote as
+/// reference points: fewer votes, and none for a pose that lies on that surface alone.
+std::vector<PpfPose> FindPpfPoses(const PpfModel& model, const std::vector<OrientedPoint>& scene,
+                                  const std::vector<OrientedPoint>& explained = {});
 
 }  // namespace ecv
