@@ -49,12 +49,7 @@ std::string Describe(const Detection& d) {
          ", depth " + std::to_string(d.depth_agreement) + ", colour " + std::to_string(d.color_agreement);
 }
 
-const GroundTruth& TruthOf(const LoadedFrame& frame, const std::string& model) {
-  for (const GroundTruth& truth : frame.ground_truth) {
-    if (truth.object_name == model) return truth;
-  }
-  throw std::runtime_error("no ground truth of " + model);
-}
+using test::TruthOf;
 
 class AcceptanceOnRealFrames : public test::YcbvLibrarySuite {
  protected:
@@ -186,10 +181,7 @@ TEST_F(AcceptanceOnRealFrames, TheGeometricEvidenceOfTheMustardBottleIsBlindToIt
 // its outline no longer steps back from the scene, and mostly the table is seen behind where it should be.
 TEST_F(AcceptanceOnRealFrames, AGreyFoamBrickIsAcceptedAtItsPoseAndRejectedTwoCentimetresOff) {
   const std::string path = directory_->File("foam_brick.sqlite");
-  const test::CommandResult build = test::RunCli(
-      "modeldb build " + test::DataPath("ycbv_subset/models/061_foam_brick/textured_simple.obj") +
-      " --name 061_foam_brick --allow-missing-textures --symmetric --views 40 --distance 0.9 --db " + path);
-  ASSERT_EQ(build.exit_code, 0) << build.output;
+  ASSERT_NO_FATAL_FAILURE(AddUntexturedModel("061_foam_brick", true, path));
   LibraryLoadOptions load;
   load.build_matchers = false;
   const ModelLibrary brick = ModelLibrary::Load(path, load);

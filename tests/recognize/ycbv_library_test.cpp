@@ -99,12 +99,7 @@ Eigen::Isometry3d GelatinBoxOnThePuddingBox() {
   return pose;
 }
 
-const GroundTruth& TruthOf(const LoadedFrame& frame, const std::string& model) {
-  for (const GroundTruth& truth : frame.ground_truth) {
-    if (truth.object_name == model) return truth;
-  }
-  throw std::runtime_error("no ground truth of " + model);
-}
+using test::TruthOf;
 
 // Verification's contour factor on the case it was made for. In video 0002 the unmodelled pudding box lies face up
 // next to the mustard bottle; recognition used to report the gelatin box lying flat on its face (at this pose, in
@@ -478,10 +473,7 @@ TEST_F(YcbvLibrary, FindsTheGelatinBoxOfOneVideoInAComposite) {
 // swapped: the same score); moved 2 cm sideways it is rejected.
 TEST_F(YcbvLibrary, AGreyModelIsAcceptedAtItsPoseByItsGeometryAndRejectedTwoCentimetresOff) {
   const std::string library_path = directory_->File("grey_brick.sqlite");
-  const test::CommandResult build = test::RunCli(
-      "modeldb build " + test::DataPath("ycbv_subset/models/061_foam_brick/textured_simple.obj") +
-      " --name 061_foam_brick --allow-missing-textures --symmetric --views 40 --distance 0.9 --db " + library_path);
-  ASSERT_EQ(build.exit_code, 0) << build.output;
+  ASSERT_NO_FATAL_FAILURE(AddUntexturedModel("061_foam_brick", true, library_path));
   LibraryLoadOptions load;
   load.build_matchers = false;
   const ModelLibrary library = ModelLibrary::Load(library_path, load);
@@ -517,13 +509,8 @@ TEST_F(YcbvLibrary, AGreyModelIsAcceptedAtItsPoseByItsGeometryAndRejectedTwoCent
 TEST_F(YcbvLibrary, PointPairsFindAGreyModelAndReportNoAbsentOne) {
   const std::string library = directory_->File("with_grey.sqlite");
   std::filesystem::copy_file(library_, library);
-  const std::string models = test::DataPath("ycbv_subset/models/");
-  for (const char* name : {"002_master_chef_can", "007_tuna_fish_can", "061_foam_brick"}) {
-    const test::CommandResult build =
-        test::RunCli("modeldb build " + models + name + "/textured_simple.obj --name " + name +
-                     " --allow-missing-textures --views 40 --distance 0.9 --db " + library +
-                     (std::string(name) != "007_tuna_fish_can" ? " --symmetric" : ""));
-    ASSERT_EQ(build.exit_code, 0) << build.output;
+  for (const std::string name : {"002_master_chef_can", "007_tuna_fish_can", "061_foam_brick"}) {
+    ASSERT_NO_FATAL_FAILURE(AddUntexturedModel(name, name != "007_tuna_fish_can", library));
   }
   LibraryLoadOptions load;
   load.build_matchers = false;

@@ -1,6 +1,7 @@
 #include "support/ycbv_library.h"
 
 #include <cstdlib>
+#include <stdexcept>
 
 #include "io/mesh_io.h"
 #include "io/pose_io.h"
@@ -33,9 +34,23 @@ void YcbvLibrarySuite::SetUpTestSuite() {
   ASSERT_EQ(banana.exit_code, 0) << banana.output;
 }
 
+void YcbvLibrarySuite::AddUntexturedModel(const std::string& name, bool symmetric, const std::string& path) {
+  const CommandResult build =
+      RunCli("modeldb build " + DataPath("ycbv_subset/models/" + name + "/textured_simple.obj") + " --name " + name +
+             " --allow-missing-textures --views 40 --distance 0.9 --db " + path + (symmetric ? " --symmetric" : ""));
+  ASSERT_EQ(build.exit_code, 0) << build.output;
+}
+
 void YcbvLibrarySuite::TearDownTestSuite() {
   delete directory_;
   directory_ = nullptr;
+}
+
+const GroundTruth& TruthOf(const LoadedFrame& frame, const std::string& model) {
+  for (const GroundTruth& truth : frame.ground_truth) {
+    if (truth.object_name == model) return truth;
+  }
+  throw std::runtime_error("no ground truth of " + model);
 }
 
 }  // namespace ecv::test

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include "io/frame_io.h"
 #include "support/test_data.h"
 
 namespace ecv::test {
@@ -17,8 +18,15 @@ class YcbvLibrarySuite : public ::testing::Test {
   static void SetUpTestSuite();
   static void TearDownTestSuite();
 
+  /// Adds the YCB-Video mesh of `name` (ycbv_subset/models) to the library at `path` as the 16-model library has it:
+  /// without its texture (one grey model), symmetric (judged by ADD-S) when `symmetric`; a test failure otherwise.
+  static void AddUntexturedModel(const std::string& name, bool symmetric, const std::string& path);
+
   static TemporaryDirectory* directory_;
   static std::string library_;  ///< the library's path
 };
+
+/// The ground truth of `model` in `frame`; throws std::runtime_error when the frame has none.
+const GroundTruth& TruthOf(const LoadedFrame& frame, const std::string& model);
 
 }  // namespace ecv::test
