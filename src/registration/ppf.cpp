@@ -449,7 +449,7 @@ PpfModel::PpfModel(std::vector<OrientedPoint> points, double diameter_m, const P
 }
 
 std::vector<PpfPose> FindPpfPoses(const PpfModel& model, const std::vector<OrientedPoint>& scene_points,
-                                  const std::vector<OrientedPoint>& explained) {
+                                  const std::vector<OrientedPoint>& explained, PpfSearchStats* stats) {
   const PpfOptions& options = model.options();
   const double diameter = model.diameter_m();
   // The reference points' candidates first, then the explained points they may pair with.
@@ -474,10 +474,13 @@ std::vector<PpfPose> FindPpfPoses(const PpfModel& model, const std::vector<Orien
   std::vector<Peak> peaks;
   const float squared_diameter = static_cast<float>(diameter * diameter);
   constexpr uint32_t kCount = 0xffffU;
+  PpfSearchStats done;
+  done.scene_points = scene.size();
   for (size_t r = 0; r < references; r += static_cast<size_t>(options.scene_reference_step)) {
     const OrientedPoint& reference = scene[r];
     const Eigen::Matrix3f to_x = ToXAxis(reference.normal);
     std::fill(accumulator.begin(), accumulator.end(), 0U);
+    ++done.references;
     uint32_t pair = 0;
     grid.ForNear(reference.position, [&](int i) {
       // A reference point has a few thousand pairs at most (its sub-sampled neighbours within one diameter); any
@@ -493,6 +496,7 @@ std::vector<PpfPose> FindPpfPoses(const PpfModel& model, const std::vector<Orien
       ++pair;
       for (int k = 0; k < count; ++k) {
         const auto [begin, end] = model.Find(keys[k]);
+        done.entries += static_cast<size_t>(end - begin);
         for (const PpfModel::Entry* entry = begin; entry != end; ++entry) {
           // alpha_model - alpha_scene, wrapped to a turn, from -pi: the rotation about x between the two frames.
           const uint32_t turn = static_cast<uint16_t>(entry->alpha - alpha_scene + 32768U);
@@ -502,6 +506,7 @@ std::vector<PpfPose> FindPpfPoses(const PpfModel& model, const std::vector<Orien
         }
       }
     });
+    done.pairs += pair;
     // The reference point's best cells as poses: camera_from_object = T_s^-1 R_x(alpha) T_m.
     BestCells(accumulator, kCount, static_cast<size_t>(options.poses_per_reference), &peaks);
     for (const Peak& peak : peaks) {
@@ -517,6 +522,7 @@ std::vector<PpfPose> FindPpfPoses(const PpfModel& model, const std::vector<Orien
       votes.push_back({pose, static_cast<double>(peak.votes)});
     }
   }
+  if (stats != nullptr) *stats = done;
   return ClusterPoses(std::move(votes), diameter, options);
 }
 

@@ -140,10 +140,19 @@ struct PpfPose {
   double votes = 0.0;  ///< the cluster's votes
 };
 
+/// What one FindPpfPoses did: its work grows with references x pairs per reference x table entries per pair.
+struct PpfSearchStats {
+  size_t scene_points = 0;  ///< sub-sampled scene points, the explained ones included
+  size_t references = 0;    ///< reference points that voted
+  size_t pairs = 0;         ///< scene pairs looked up in the table
+  size_t entries = 0;       ///< table entries voted for
+};
+
 /// The model's best pose clusters among `scene` points (camera frame, normals towards the camera), most votes first.
 /// `explained` points (a surface a detection already accounts for) pair with the scene's but lead no vote as
 /// reference points: fewer votes, and none for a pose that lies on that surface alone.
+/// `stats`, when given, receives what the search did.
 std::vector<PpfPose> FindPpfPoses(const PpfModel& model, const std::vector<OrientedPoint>& scene,
-                                  const std::vector<OrientedPoint>& explained = {});
+                                  const std::vector<OrientedPoint>& explained = {}, PpfSearchStats* stats = nullptr);
 
 }  // namespace ecv

@@ -93,7 +93,19 @@ TEST(Ppf, ExplainedPointsLeadNoVote) {
   const TriangleMesh box = Box();
   const PpfModel model(SampleMeshSurface(box, 20000), box.Diameter());
   const BoxOnTable scene = MakeBoxOnTable(box, kBoxPose);
-  const std::vector<PpfPose> box_explained = FindPpfPoses(model, scene.table, scene.box);
+  PpfSearchStats stats;
+  const std::vector<PpfPose> box_explained = FindPpfPoses(model, scene.table, scene.box, &stats);
+  // Only the table's sub-sampled points lead, every scene_reference_step-th of them; the box's are paired with.
+  const PpfOptions& options = model.options();
+  const size_t table =
+      SubsampleByNormals(scene.table, options.sampling * box.Diameter(), options.scene_keep_normal_deg).size();
+  const size_t box_points =
+      SubsampleByNormals(scene.box, options.sampling * box.Diameter(), options.scene_keep_normal_deg).size();
+  const auto step = static_cast<size_t>(options.scene_reference_step);
+  EXPECT_EQ(stats.scene_points, table + box_points);
+  EXPECT_EQ(stats.references, (table + step - 1) / step);
+  EXPECT_GT(stats.pairs, stats.references);
+  EXPECT_GT(stats.entries, 0U);
   for (const PpfPose& pose : box_explained) {
     EXPECT_FALSE(TranslationDistance(pose.camera_from_object, kBoxPose) < 0.01 &&
                  BoxAngle(pose.camera_from_object, kBoxPose) < 10.0 * kDegree);
