@@ -439,35 +439,24 @@ class Recognizer::Impl {
   }
 
   // The model's best point pair pose clusters among the scene's oriented `points` (the `explained` ones only paired
-  // with), each verified; the best of them and its rivals refined by ICP and verified again (the better kept); the
-  // best of all.
+  // with), each verified, refined by ICP and verified again (the better kept); the best of them.
   std::optional<VerifiedPose> BestPointPairPose(size_t model, const Scene& scene,
                                                 const std::vector<OrientedPoint>& points,
                                                 const std::vector<OrientedPoint>& explained, StageTimes* times) {
     Clock::time_point stage = Clock::now();
     const std::vector<PpfPose> poses = FindPpfPoses(*models_[model].point_pairs, points, explained);
     times->Add(Stage::kPointPairs, MillisecondsSince(stage));
-    std::vector<std::pair<Hypothesis, VerifiedPose>> verified;
+    const ModelSearch search = Search(model, scene, 1);
+    std::optional<VerifiedPose> best;
     for (size_t c = 0; c < poses.size() && c < static_cast<size_t>(options_.point_pairs.clusters); ++c) {
       Hypothesis hypothesis;
       hypothesis.pose = poses[c].camera_from_object;
       stage = Clock::now();
-      VerifiedPose pose = Verify(model, scene, hypothesis);
+      VerifiedPose verified = Verify(model, scene, hypothesis);
       times->Add(Stage::kVerify, MillisecondsSince(stage));
-      verified.emplace_back(hypothesis, std::move(pose));
-    }
-    // As the context's search does: the best coarse pose is refined, and those scoring rival_min_ratio of it.
-    std::stable_sort(verified.begin(), verified.end(),
-                     [](const auto& a, const auto& b) { return a.second.search_score > b.second.search_score; });
-    const ModelSearch search = Search(model, scene, 1);
-    const double best_coarse = verified.empty() ? 0.0 : verified.front().second.search_score;
-    std::optional<VerifiedPose> best;
-    for (size_t i = 0; i < verified.size(); ++i) {
-      auto& [hypothesis, pose] = verified[i];
-      const bool rival = pose.search_score > 0.0 && pose.search_score >= options_.rival_min_ratio * best_coarse;
-      if (options_.refine && (i == 0 || rival)) RefineIfBetter(model, scene, search, &hypothesis, &pose, times);
-      pose.detection.hypothesis_source = HypothesisSource::kPpf;
-      if (!best || pose.detection.score > best->detection.score) best = std::move(pose);
+      if (options_.refine) RefineIfBetter(model, scene, search, &hypothesis, &verified, times);
+      verified.detection.hypothesis_source = HypothesisSource::kPpf;
+      if (!best || verified.detection.score > best->detection.score) best = std::move(verified);
     }
     return best;
   }

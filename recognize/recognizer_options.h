@@ -88,9 +88,7 @@ struct PointPairOptions {
   /// scene's points (remove_plane false: never).
   bool remove_plane = true;
   ScenePlaneOptions plane;
-  /// The best pose clusters verified per model; the best of them refined by ICP, and those scoring
-  /// RecognizerOptions::rival_min_ratio of it.
-  int clusters = 5;
+  int clusters = 5;  ///< the best pose clusters refined and verified per model
   /// Points spread over a model's mesh before sub-sampling. A library's stored points are used when they were drawn
   /// alike (PpfModelSampling); otherwise the model's points are drawn from its mesh when the recognizer loads.
   int model_samples = PpfModelSampling().samples;
@@ -142,7 +140,7 @@ struct RecognizerOptions {
   double give_up_below_score = 0.1;
   /// Beyond the best verified pose of a model, its best pose turned more than 90 degrees from it is refined and
   /// verified too when it scored at least this share of the best (0: never): coarse poses of a bottle's front and
-  /// back score alike before ICP, and which one is refined decides. Point pair clusters scoring it are refined too.
+  /// back score alike before ICP, and which one is refined decides.
   double rival_min_ratio = 0.7;
   /// Each searched model's best pose is also tried turned 180 degrees about the model's principal axes.
   TwinOptions twins;

@@ -278,7 +278,7 @@ void AddFurtherSettings(std::vector<Setting>* table) {
   table->push_back(Number(
       "rival-min-ratio", 0, 1,
       "A model's best pose turned more than 90 degrees from its best verified one is refined and verified\n"
-      "too when it scored at least this share of the best (0: never); so are the point pair clusters that did",
+      "too when it scored at least this share of the best (0: never)",
       [](auto& s) -> auto& { return s.options.rival_min_ratio; }));
   table->push_back(Flag(
       "twins", true,
@@ -295,8 +295,7 @@ void AddFurtherSettings(std::vector<Setting>* table) {
       [](auto& s) -> auto& { return s.options.icp_max_points; }));
   table->push_back(Count(
       "ppf-clusters", 1, kNoMax,
-      "With --hypotheses ppf or both: the best point pair pose clusters verified per model (the best of them refined "
-      "by ICP, and those scoring --rival-min-ratio of it)",
+      "With --hypotheses ppf or both: the best point pair pose clusters refined and verified per model",
       [](auto& s) -> auto& { return s.options.point_pairs.clusters; }));
   table->push_back(FlagOf(
       "ppf-keep-plane", false,
