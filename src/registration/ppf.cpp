@@ -476,11 +476,12 @@ std::vector<PpfPose> FindPpfPoses(const PpfModel& model, const std::vector<Orien
   constexpr uint32_t kCount = 0xffffU;
   PpfSearchStats done;
   done.scene_points = scene.size();
-  for (size_t r = 0; r < references; r += static_cast<size_t>(options.scene_reference_step)) {
+  const auto step = static_cast<size_t>(options.scene_reference_step);
+  done.references = (references + step - 1) / step;
+  for (size_t r = 0; r < references; r += step) {
     const OrientedPoint& reference = scene[r];
     const Eigen::Matrix3f to_x = ToXAxis(reference.normal);
     std::fill(accumulator.begin(), accumulator.end(), 0U);
-    ++done.references;
     uint32_t pair = 0;
     grid.ForNear(reference.position, [&](int i) {
       // A reference point has a few thousand pairs at most (its sub-sampled neighbours within one diameter); any
