@@ -1,6 +1,7 @@
 // `ecvpose modeldb`: build a model library from meshes into SQLite, and list, inspect, remove, verify, export
 // and migrate it. Compiled only into the ecvpose executable; reads flags into options and calls ecv_modeldb.
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -8,6 +9,7 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "app/commands.h"
@@ -42,6 +44,9 @@ struct ModeldbArgs {
   bool no_stored_mesh = false;
   bool no_point_pairs = false;
   int mesh_texture_size = MeshBlobOptions().max_texture_size;
+  std::string shard;  // "I/N": build only the I-th of N parts (0 <= I < N)
+  // merge
+  std::vector<std::string> shards;
   // list, info, remove, export, verify
   std::string model;
   bool json = false;
@@ -113,6 +118,19 @@ ModelSource SourceDefaults(const ModeldbArgs& args) {
   return defaults;
 }
 
+// --shard I/N as (I, N); (0, 1) when not given.
+std::pair<int, int> ShardArgument(const std::string& text) {
+  if (text.empty()) return {0, 1};
+  int index = -1, parts = 0;
+  char slash = 0;
+  std::istringstream in(text);
+  if (!(in >> index >> slash >> parts) || slash != '/' || !(in >> std::ws).eof() || parts < 1 || index < 0 ||
+      index >= parts) {
+    ThrowInputError("--shard", "part of the build", "I/N with 0 <= I < N, e.g. 0/4", text);
+  }
+  return {index, parts};
+}
+
 // Progress on stderr: a line per view and per model stored, a FAILED line per model that could not be built.
 LibraryBuildReporter BuildReporter(const ModelBuildOptions& options) {
   const auto prefix = std::make_shared<std::string>();
@@ -152,8 +170,9 @@ int RunBuild(const ModeldbArgs& args) {
     return kExitBadUsage;
   }
   const ModelBuildOptions options = BuildArguments(args);
-  const MeshSourceScan scan =
-      FindMeshSources(args.inputs, SourceDefaults(args), args.mesh.object_from_mesh_path.empty());
+  const auto [shard, parts] = ShardArgument(args.shard);
+  MeshSourceScan scan = FindMeshSources(args.inputs, SourceDefaults(args), args.mesh.object_from_mesh_path.empty());
+  KeepShard(shard, parts, &scan);
   if (!args.name.empty() && scan.sources.size() > 1) {
     std::cerr << "ecvpose modeldb build: --name needs a single mesh, " << args.inputs[0] << " holds "
               << scan.sources.size() << '\n';
@@ -163,13 +182,26 @@ int RunBuild(const ModeldbArgs& args) {
   const LibraryBuildSummary summary = BuildLibrary(args.db, scan.sources, options, BuildReporter(options));
   std::cout << "built " << summary.built.size() << " of " << scan.sources.size() + scan.problems.size()
             << " models into " << args.db;
+  if (parts > 1) std::cout << " (shard " << shard << "/" << parts << ")";
   if (!summary.failed.empty() || !scan.problems.empty()) {
     std::cout << "; failed (see above):";
     for (const std::string& name : summary.failed) std::cout << ' ' << name;
     for (const std::string& problem : scan.problems) std::cout << ' ' << problem.substr(0, problem.find(':'));
   }
   std::cout << '\n';
-  return summary.failed.empty() && scan.problems.empty() && !summary.built.empty() ? kExitOk : kExitBadInput;
+  // A part may hold no model (fewer models than parts); a whole build must hold one.
+  const bool some = !summary.built.empty() || (parts > 1 && scan.sources.empty());
+  return summary.failed.empty() && scan.problems.empty() && some ? kExitOk : kExitBadInput;
+}
+
+int RunMerge(const ModeldbArgs& args) {
+  LibraryMergeReporter reporter;
+  reporter.copied = [](const std::string& model, const std::string& shard, int number, int count) {
+    std::cerr << "modeldb: [" << number << "/" << count << "] " << model << " from " << shard << '\n';
+  };
+  const int models = MergeLibraries(args.db, args.shards, reporter);
+  std::cout << "merged " << models << " models of " << args.shards.size() << " libraries into " << args.db << '\n';
+  return kExitOk;
 }
 
 // null when none were made; else the points and pairs, and the refusal of a mesh that has none.
@@ -365,6 +397,9 @@ void AddBuildFlags(CLI::App& build, ModeldbArgs* args) {
                   "Largest side of a stored mesh's textures, pixels (larger ones are downscaled; 0: as they are)")
       ->capture_default_str()
       ->check(NonNegative());
+  build.add_option("--shard", args->shard,
+                   "I/N: build only part I (0 <= I < N) of N, the models split by name alike on every machine, into "
+                   "a library of its own; `modeldb merge` joins the parts");
   build.add_option("--feature-settings", args->feature_settings,
                    "JSON of extraction and descriptor settings, {\"ecv\": {...}, \"descriptor\": {...}} as "
                    "`modeldb info` shows them (missing fields: defaults); for a camera not held level, "
@@ -402,7 +437,14 @@ CommandAction SetupModeldbCommand(CLI::App& command) {
       ->capture_default_str();
   CLI::App* migrate =
       AddDatabaseCommand(command, "migrate", "Bring a library of an older schema up to date", args.get());
-  return [args, build, list, info, remove, verify, exported, migrate]() -> int {
+  CLI::App* merge = command.add_subcommand("merge", "Join libraries (the parts of a build --shard) into one");
+  merge->add_option("OUT", args->db, "The merged library (created if missing)")->required();
+  merge->add_option("LIBRARY", args->shards, "Libraries built with the same feature settings")->required();
+  merge->footer(
+      "Models are copied in name order, each in one transaction with its colour matrix: the merged parts of a\n"
+      "build equal one build of all the models. Refused before anything is written: mixed feature settings or\n"
+      "schema versions, a model in two libraries. A model of OUT with the same name is replaced.");
+  return [args, build, list, info, remove, verify, exported, migrate, merge]() -> int {
     if (build->parsed()) return RunBuild(*args);
     if (list->parsed()) return RunList(*args);
     if (info->parsed()) return RunInfo(*args);
@@ -410,6 +452,7 @@ CommandAction SetupModeldbCommand(CLI::App& command) {
     if (verify->parsed()) return RunVerify(*args);
     if (exported->parsed()) return RunExport(*args);
     if (migrate->parsed()) return RunMigrate(*args);
+    if (merge->parsed()) return RunMerge(*args);
     return kExitBadUsage;
   };
 }

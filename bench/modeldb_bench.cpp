@@ -6,21 +6,26 @@
 //  3. Scaling: load and query time for libraries of 10, 100 and 1000 models, synthesised by re-adding the
 //     built models' views under new names (fewer views per model there; said in the table).
 //  Peer: the same records read from a flat binary file (no SQL, no index) in the same run.
-// Replaces its section of bench/RESULTS.md (bench_util ReportSection).
+//  With --parts instead: every object of ycb_objects built by `ecvpose modeldb build` in one process on every core,
+//  against parts built side by side on one core each (--shard) and then merged (`modeldb merge`).
+// Replaces its section of bench/RESULTS.md (bench_util ReportSection); --parts has a section of its own.
 //
 //   modeldb_bench [--views N] [--fit-views N] [--scale-views N] [--study-views N] [--scales N,N,...] [--data DIR]
 //                 [--work DIR] [--results FILE]
+//   modeldb_bench --parts [--views N] [--data DIR] [--work DIR] [--results FILE]
 
 #include <sys/stat.h>
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -53,6 +58,7 @@ struct Settings {
   std::string work = "/tmp/modeldb_bench";
   std::string results = std::string(ECV_SOURCE_DIR) + "/bench/RESULTS.md";
   std::string command = "modeldb_bench";
+  bool parts = false;  // the parts comparison instead of the rest
 };
 
 double MegaBytes(double bytes) {
@@ -382,6 +388,70 @@ std::string LoadRow(const std::string& what, double sqlite_ms, double flat_ms, d
 
 }  // namespace
 
+// Runs `command` (shell) and returns its wall time in seconds; throws when it fails.
+double TimedShell(const std::string& command) {
+  const auto start = Clock::now();
+  const int code = ecv::bench::RunShellCommand(command);
+  if (code != 0) throw std::runtime_error("exit code " + std::to_string(code) + " of: " + command);
+  return MillisecondsSince(start) / 1000.0;
+}
+
+// The library's models as (name, mesh digest, descriptor digest, views): what equal libraries share.
+std::vector<std::string> ModelDigests(const std::string& path) {
+  std::vector<std::string> digests;
+  for (const ecv::ModelSummary& m : ecv::ModelDatabase(path, ecv::OpenMode::kReadOnly).ListModels()) {
+    digests.push_back(std::to_string(m.id) + " " + m.name + " " + m.mesh_sha256 + " " + m.descriptor_sha256 + " " +
+                      std::to_string(m.num_views));
+  }
+  return digests;
+}
+
+// The whole YCB set: one build on both cores against two parts side by side on one core each, then their merge.
+void PartsComparison(const Settings& settings) {
+  using ecv::bench::ShellQuoted;
+  const std::string cli = ShellQuoted(ECV_CLI_PATH);
+  const std::string meshes = ShellQuoted(settings.data + "/ycb_objects");
+  const std::string views = " --views " + std::to_string(settings.views);
+  const std::string work = settings.work + "/parts";
+  fs::remove_all(work);
+  fs::create_directories(work);
+  const auto library = [&](const std::string& name) { return ShellQuoted(work + "/" + name + ".sqlite"); };
+  const std::string quiet = " > /dev/null 2>> " + ShellQuoted(work + "/build.log");
+  std::cerr << "modeldb_bench: one build of " << settings.data << "/ycb_objects on 2 threads\n";
+  const double one_s =
+      TimedShell(cli + " modeldb build " + meshes + " --db " + library("one") + " --threads 2" + views + quiet);
+  std::cerr << "modeldb_bench: 2 parts side by side on 1 thread each\n";
+  const double parts_s =
+      TimedShell("(" + cli + " modeldb build " + meshes + " --db " + library("part0") + " --shard 0/2 --threads 1" +
+                 views + quiet + " & first=$!; " + cli + " modeldb build " + meshes + " --db " + library("part1") +
+                 " --shard 1/2 --threads 1" + views + quiet + " & second=$!; wait $first && wait $second)");
+  const double merge_s =
+      TimedShell(cli + " modeldb merge " + library("merged") + " " + library("part0") + " " + library("part1") + quiet);
+  const std::vector<std::string> one = ModelDigests(work + "/one.sqlite");
+  const std::vector<std::string> merged = ModelDigests(work + "/merged.sqlite");
+  const size_t part0 = ModelDigests(work + "/part0.sqlite").size();
+  const size_t part1 = ModelDigests(work + "/part1.sqlite").size();
+  std::string markdown =
+      "Every object of `ycb_objects` (google_16k meshes, 4096^2 textures), " + std::to_string(settings.views) +
+      " views per model, `ecvpose modeldb build` on this 2-core machine: one process with `--threads 2` against two "
+      "processes side by side, `--shard 0/2` and `--shard 1/2` with `--threads 1` each, then `modeldb merge` of the "
+      "two parts. Equal = the merged library has the one build's models, numbers, mesh and descriptor digests and "
+      "views.\n\n| build | models | wall s | s per model | vs one process |\n|---|---:|---:|---:|---:|\n";
+  const auto row = [&](const std::string& name, size_t models, double seconds) {
+    markdown += "| " + name + " | " + std::to_string(models) + " | " + Fixed(seconds, 1) + " | " +
+                Fixed(seconds / std::max<size_t>(models, 1), 2) + " | " + Fixed(seconds / one_s, 2) + " |\n";
+  };
+  row("one process, 2 threads", one.size(), one_s);
+  row("2 parts side by side (" + std::to_string(part0) + " + " + std::to_string(part1) + " models), 1 thread each",
+      merged.size(), parts_s);
+  row("merge of the 2 parts", merged.size(), merge_s);
+  row("2 parts + merge", merged.size(), parts_s + merge_s);
+  markdown += "\nMerged library equal to the one build: " + std::string(one == merged ? "yes" : "**no**") + " (" +
+              Fixed(MegaBytes(FileBytes(work + "/merged.sqlite")), 0) + " MB).\n";
+  ecv::bench::ReportSection(settings.results, "Model library built in parts (modeldb_bench --parts)", settings.command,
+                            markdown);
+}
+
 int main(int argc, char** argv) {
   Settings settings;
   settings.command = ecv::bench::CommandLine(argc, argv);
@@ -405,8 +475,14 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--results", settings.results, "Markdown file whose section of this bench the report replaces")
       ->capture_default_str();
+  app.add_flag("--parts", settings.parts,
+               "Only the whole YCB set (ycb_objects) built in one process against two parts side by side, merged");
   if (const auto exit_code = ecv::bench::ParseCommandLine(app, argc, argv)) return *exit_code;
   try {
+    if (settings.parts) {
+      PartsComparison(settings);
+      return 0;
+    }
     fs::create_directories(settings.work);
     const std::string path = settings.work + "/ycb.sqlite";
     fs::remove(path);

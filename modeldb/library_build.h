@@ -33,4 +33,19 @@ struct LibraryBuildSummary {
 LibraryBuildSummary BuildLibrary(const std::string& db_path, const std::vector<ModelSource>& sources,
                                  const ModelBuildOptions& options, const LibraryBuildReporter& reporter = {});
 
+/// What MergeLibraries says as it goes.
+struct LibraryMergeReporter {
+  /// A model was copied: its name, the library it came from, and its place among them, 1..count.
+  std::function<void(const std::string& model, const std::string& shard, int number, int count)> copied;
+};
+
+/// Copies every model of the libraries `shard_paths` (e.g. the parts of a build split by `modeldb build --shard`)
+/// into the library at `out_path`, created if missing: in name order, each model in one transaction with its colour
+/// matrix, so that the result holds the same models, views, descriptors and content digests as one build of them
+/// all. Checked before anything is written, each an InputError naming the libraries: every shard opens as a library
+/// of the current schema; all have the same feature settings (as `out_path`, if it holds models); no model is in two
+/// shards; `out_path` is none of them. A model of that name in `out_path` is replaced. Returns the models copied.
+int MergeLibraries(const std::string& out_path, const std::vector<std::string>& shard_paths,
+                   const LibraryMergeReporter& reporter = {});
+
 }  // namespace ecv

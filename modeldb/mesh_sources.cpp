@@ -1,6 +1,7 @@
 #include "modeldb/mesh_sources.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <filesystem>
 
 #include "core/error.h"
@@ -83,6 +84,27 @@ MeshSourceScan FindMeshSources(const std::vector<std::string>& paths, const Mode
     }
   }
   return scan;
+}
+
+int ShardOfName(const std::string& name, int parts) {
+  if (parts <= 1) return 0;
+  uint64_t hash = 14695981039346656037ULL;  // FNV-1a, 64 bits
+  for (const char c : name) {
+    hash ^= static_cast<unsigned char>(c);
+    hash *= 1099511628211ULL;
+  }
+  return static_cast<int>(hash % static_cast<uint64_t>(parts));
+}
+
+void KeepShard(int part, int parts, MeshSourceScan* scan) {
+  const auto other = [&](const std::string& key) { return ShardOfName(key, parts) != part; };
+  std::vector<ModelSource>& sources = scan->sources;
+  sources.erase(std::remove_if(sources.begin(), sources.end(), [&](const ModelSource& s) { return other(s.name); }),
+                sources.end());
+  std::vector<std::string>& problems = scan->problems;
+  problems.erase(std::remove_if(problems.begin(), problems.end(),
+                                [&](const std::string& p) { return other(p.substr(0, p.find(':'))); }),
+                 problems.end());
 }
 
 }  // namespace ecv

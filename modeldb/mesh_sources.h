@@ -23,6 +23,14 @@ struct MeshSourceScan {
 MeshSourceScan FindMeshSources(const std::vector<std::string>& paths, const ModelSource& defaults,
                                bool use_pose_files = true);
 
+/// The part, 0..parts-1, that a model of this name belongs to when a build is split into `parts` (modeldb build
+/// --shard): FNV-1a of the name's bytes, so the same on every machine and unchanged when models are added.
+int ShardOfName(const std::string& name, int parts);
+
+/// Keeps the sources of part `part` (0..parts-1) and the problems whose name or path (the text before their first
+/// ':') falls into it, so that the parts of a scan hold each of its models and problems once.
+void KeepShard(int part, int parts, MeshSourceScan* scan);
+
 /// Name of the pose file looked for beside each mesh.
 inline constexpr const char* kObjectFromMeshFile = "object_from_mesh.json";
 

@@ -154,9 +154,13 @@ void ModelDatabaseOptions::Check() const {
 }
 
 ModelDatabase::ModelDatabase(const std::string& path, OpenMode mode, const ModelDatabaseOptions& options)
-    : impl_(std::make_unique<Impl>(Impl{OpenLibrary(path, mode, options)})) {}
+    : impl_(std::make_unique<Impl>(Impl{OpenLibrary(path, mode, options), mode != OpenMode::kReadOnly})) {}
 
-ModelDatabase::~ModelDatabase() = default;
+// A library its writer has finished is left with a rollback journal, so that its readers add no files beside it.
+ModelDatabase::~ModelDatabase() {
+  if (impl_ && impl_->writable) impl_->connection.LeaveWriteAheadLog();
+}
+
 ModelDatabase::ModelDatabase(ModelDatabase&&) noexcept = default;
 ModelDatabase& ModelDatabase::operator=(ModelDatabase&&) noexcept = default;
 
@@ -174,6 +178,15 @@ std::optional<FeatureSettings> ModelDatabase::feature_settings() const {
 }
 
 AddModelResult ModelDatabase::AddModel(const ModelRecord& record, const InsertProgress& progress) {
+  return Insert(record, std::nullopt, progress);
+}
+
+AddModelResult ModelDatabase::AddModel(const StoredModel& model, const InsertProgress& progress) {
+  return Insert(model.record, model.color_matrix, progress);
+}
+
+AddModelResult ModelDatabase::Insert(const ModelRecord& record, const std::optional<ColorMatrixRecord>& color_matrix,
+                                     const InsertProgress& progress) {
   SqlConnection& connection = impl_->connection;
   CheckRecord(record, connection.path());
   const auto start = std::chrono::steady_clock::now();
@@ -202,7 +215,8 @@ AddModelResult ModelDatabase::AddModel(const ModelRecord& record, const InsertPr
   }
   if (!record.mesh_blob.empty()) InsertMeshBlob(connection, model_id, record.mesh_blob);
   if (record.point_pairs) detail::InsertPointPairs(connection, model_id, *record.point_pairs);
-  if (kept_matrix) WriteColorMatrix(connection, model_id, *kept_matrix, kept_matrix->created);
+  const std::optional<ColorMatrixRecord>& matrix = color_matrix ? color_matrix : kept_matrix;
+  if (matrix) WriteColorMatrix(connection, model_id, *matrix, matrix->created);
   transaction.Commit();
   result.insert_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return result;
@@ -268,7 +282,7 @@ ModelDbMigration MigrateModelDatabase(const std::string& path, const ModelDataba
   options.Check();
   SqlConnection connection = OpenConnection(path, OpenMode::kReadWrite, options);
   const MigrationResult migrated = MigrateSchema(connection);
-  UseWriteAheadLog(connection);
+  connection.LeaveWriteAheadLog();
   return {migrated.from_version, migrated.to_version, migrated.steps, migrated.notes};
 }
 

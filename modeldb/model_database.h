@@ -48,8 +48,9 @@ struct VerifyReport {
 
 /// The object library in one SQLite file (schema in modeldb/README.md): models, their meshes, views, primitives in
 /// the object frame, descriptors, colour matrices, and the feature settings every model was built with.
-/// Every change is one transaction: a model is in the library whole or not at all. Write-ahead logging
-/// lets readers load while a writer adds. One object must not be used by two threads at once.
+/// Every change is one transaction: a model is in the library whole or not at all. While a writer has the file
+/// open it is write-ahead logged (readers load while it adds); a writer that closes it last leaves it with a
+/// rollback journal, so that readers leave no -wal or -shm file. One object must not be used by two threads at once.
 class ModelDatabase {
  public:
   /// Opens `path` (":memory:" for a database in memory). Throws InputError naming the file for a missing
@@ -70,6 +71,9 @@ class ModelDatabase {
   /// kept when the mesh content is the same). Throws InputError when the record's feature settings differ
   /// from the library's, or for an empty name or a record without views.
   AddModelResult AddModel(const ModelRecord& record, const InsertProgress& progress = {});
+  /// AddModel of a model as another library stored it (LoadModels): its colour matrix, if it has one, is stored in
+  /// the same transaction, with its creation time.
+  AddModelResult AddModel(const StoredModel& model, const InsertProgress& progress = {});
 
   /// All models, by name.
   std::vector<ModelSummary> ListModels() const;
@@ -101,6 +105,9 @@ class ModelDatabase {
 
  private:
   struct Impl;
+  AddModelResult Insert(const ModelRecord& record, const std::optional<ColorMatrixRecord>& color_matrix,
+                        const InsertProgress& progress);
+
   std::unique_ptr<Impl> impl_;
 };
 

@@ -15,6 +15,7 @@ namespace ecv {
 
 struct ModelDatabase::Impl {
   SqlConnection connection;
+  bool writable = false;
 };
 
 namespace detail {

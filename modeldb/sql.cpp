@@ -139,6 +139,22 @@ SqlConnection::SqlConnection(const std::string& path, SqlOpenMode mode, int busy
   }
 }
 
+bool SqlConnection::LeaveWriteAheadLog() noexcept {
+  if (!impl_ || impl_->db == nullptr || impl_->path == ":memory:" || impl_->immutable) return false;
+  sqlite3_busy_handler(impl_->db, nullptr, nullptr);  // another connection's lock: give up at once
+  const int code = sqlite3_exec(impl_->db, "PRAGMA journal_mode = DELETE", nullptr, nullptr, nullptr);
+  sqlite3_busy_handler(impl_->db, &Impl::WaitForLock, impl_.get());
+  sqlite3_stmt* statement = nullptr;
+  bool left = false;
+  if (code == SQLITE_OK && sqlite3_prepare_v2(impl_->db, "PRAGMA journal_mode", -1, &statement, nullptr) == SQLITE_OK &&
+      sqlite3_step(statement) == SQLITE_ROW) {
+    const auto* mode = reinterpret_cast<const char*>(sqlite3_column_text(statement, 0));
+    left = mode != nullptr && std::string(mode) == "delete";
+  }
+  sqlite3_finalize(statement);
+  return left;
+}
+
 SqlConnection::~SqlConnection() = default;
 SqlConnection::SqlConnection(SqlConnection&&) noexcept = default;
 SqlConnection& SqlConnection::operator=(SqlConnection&&) noexcept = default;

@@ -59,6 +59,11 @@ class SqlConnection {
   /// Rolls back the open transaction, if any; never throws (for destructors and error paths).
   void RollbackIfActive() noexcept;
 
+  /// Switches a write-ahead-logged file back to a rollback journal (the log checkpointed into the file), so that
+  /// readers leave no -wal or -shm file beside it. Does not wait: false, and the file stays as it is, while another
+  /// connection has it open. Never throws (for destructors).
+  bool LeaveWriteAheadLog() noexcept;
+
   const std::string& path() const;
 
   /// True when opened read-only because the location cannot be written (no WAL shared memory possible).

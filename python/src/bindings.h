@@ -32,6 +32,8 @@ threads: worker threads, 0 (every core) or 1 to 256; the library is the same for
 stored_mesh, mesh_texture_size: store each mesh in the library (textures at most this many pixels a side).
 point_pairs: store each model's point pair points (shape-driven hypotheses; False: as `--no-ppf`).
 feature_settings: a dict of extraction and descriptor settings as `ecvpose modeldb info` shows them.
+shard: (part, parts): only the models of that part, 0 <= part < parts, split by name alike on every machine (as
+    `modeldb build --shard part/parts`); merge_libraries joins the parts' libraries.
 progress: called as progress(model, view, views) after each view.
 
 Returns the names of the models built. Raises InputError naming each model that failed, after building the others.)";

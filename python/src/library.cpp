@@ -66,7 +66,8 @@ struct BuildArguments {
   bool stored_mesh = true;
   bool point_pairs = true;
   int mesh_texture_size = MeshBlobOptions().max_texture_size;
-  py::object feature_settings;  // None or a dict as `modeldb info` shows them
+  py::object feature_settings;      // None or a dict as `modeldb info` shows them
+  std::pair<int, int> shard{0, 1};  // (part, parts): build only that part of the models (modeldb build --shard)
 };
 
 ModelBuildOptions BuildOptions(const BuildArguments& args) {
@@ -127,7 +128,13 @@ std::vector<std::string> BuildModels(const std::string& db, const std::vector<st
                                      const BuildArguments& args, const py::object& progress) {
   if (meshes.empty()) ThrowInputError("meshes", "", "at least one mesh file or directory", "none");
   const ModelBuildOptions options = BuildOptions(args);
-  const MeshSourceScan scan = FindMeshSources(meshes, SourceDefaults(args), args.object_from_mesh.is_none());
+  const auto [part, parts] = args.shard;
+  if (parts < 1 || part < 0 || part >= parts) {
+    ThrowInputError("shard", "", "(part, parts) with 0 <= part < parts",
+                    "(" + std::to_string(part) + ", " + std::to_string(parts) + ")");
+  }
+  MeshSourceScan scan = FindMeshSources(meshes, SourceDefaults(args), args.object_from_mesh.is_none());
+  KeepShard(part, parts, &scan);
   if (args.name && scan.sources.size() != 1) {
     ThrowInputError("name", "", "one mesh to name", std::to_string(scan.sources.size()) + " meshes");
   }
@@ -193,7 +200,8 @@ void BindLibrary(py::module_& m) {
       [](const std::string& db, const py::object& meshes, std::optional<std::string> name, std::string unit,
          py::object object_from_mesh, bool symmetric, bool allow_missing_textures, int views, double distance,
          py::object camera, std::pair<int, int> size, std::string shading, int threads, bool stored_mesh,
-         bool point_pairs, int mesh_texture_size, py::object feature_settings, py::object progress) {
+         bool point_pairs, int mesh_texture_size, py::object feature_settings, std::pair<int, int> shard,
+         py::object progress) {
         const std::vector<std::string> paths = py::isinstance<py::str>(meshes)
                                                    ? std::vector<std::string>{meshes.cast<std::string>()}
                                                    : meshes.cast<std::vector<std::string>>();
@@ -213,6 +221,7 @@ void BindLibrary(py::module_& m) {
         args.point_pairs = point_pairs;
         args.mesh_texture_size = mesh_texture_size;
         args.feature_settings = std::move(feature_settings);
+        args.shard = shard;
         return BuildModels(db, paths, args, progress);
       },
       py::arg("db"), py::arg("meshes"), py::kw_only(), py::arg("name") = py::none(), py::arg("unit") = "m",
@@ -222,7 +231,27 @@ void BindLibrary(py::module_& m) {
       py::arg("size") = std::pair<int, int>{640, 480}, py::arg("shading") = "auto", py::arg("threads") = 0,
       py::arg("stored_mesh") = true, py::arg("point_pairs") = true,
       py::arg("mesh_texture_size") = MeshBlobOptions().max_texture_size, py::arg("feature_settings") = py::none(),
-      py::arg("progress") = py::none(), kBuildModelsDoc);
+      py::arg("shard") = std::pair<int, int>{0, 1}, py::arg("progress") = py::none(), kBuildModelsDoc);
+
+  m.def(
+      "merge_libraries",
+      [](const std::string& out, const std::vector<std::string>& libraries, const py::object& progress) {
+        LibraryMergeReporter reporter;
+        if (!progress.is_none()) {
+          reporter.copied = [&](const std::string& model, const std::string& shard, int number, int count) {
+            const py::gil_scoped_acquire acquire;
+            progress(model, shard, number, count);
+          };
+        }
+        const py::gil_scoped_release release;
+        return MergeLibraries(out, libraries, reporter);
+      },
+      py::arg("out"), py::arg("libraries"), py::kw_only(), py::arg("progress") = py::none(),
+      "Copies every model of `libraries` (the parts of a build with `shard`) into the library `out` (created if "
+      "missing), as `ecvpose modeldb merge` does: in name order, each model in one transaction with its colour matrix. "
+      "Raises InputError, before writing anything, for libraries of other feature settings or schema versions and a "
+      "model in two of them. progress(model, library, number, count) is called after each model. Returns the number "
+      "of models copied.");
 
   m.def(
       "render",

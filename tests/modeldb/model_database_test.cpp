@@ -2,7 +2,10 @@
 // removal, colour matrices, feature settings, verification, bad files, schema versions and migration.
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
+#include <map>
+#include <optional>
 #include <string>
 
 #include <gmock/gmock.h>
@@ -11,6 +14,8 @@
 
 #include "core/error.h"
 #include "modeldb/content_hash.h"
+#include "modeldb/library_build.h"
+#include "modeldb/mesh_sources.h"
 #include "modeldb/model_database.h"
 #include "modeldb/schema.h"
 #include "modeldb/sql.h"
@@ -544,6 +549,138 @@ TEST(SqlConnection, AWriterWaitingForTheLockSaysSoAndFailsAtOpen) {
   holder.Execute("ROLLBACK");
   EXPECT_NO_THROW(SqlConnection(path, SqlOpenMode::kReadWrite, 1500));
   EXPECT_NO_THROW(SqlConnection(path, SqlOpenMode::kReadOnly, 1500));
+}
+
+std::string JournalMode(const std::string& path) {
+  SqlConnection connection(path, SqlOpenMode::kReadOnly, 1000);
+  SqlStatement mode = connection.Prepare("PRAGMA journal_mode");
+  mode.Step();
+  return mode.Text(0);
+}
+
+bool HasLogFiles(const std::string& path) {
+  return std::filesystem::exists(path + "-wal") || std::filesystem::exists(path + "-shm");
+}
+
+// Many recognizers read one finished library: they must not need to write beside it.
+TEST(ModelDatabase, AWriterLeavesAFinishedLibraryWithoutALogForItsReaders) {
+  const test::TemporaryDirectory directory;
+  const std::string path = directory.File("lib.sqlite");
+  ModelDatabase(path, OpenMode::kCreate).AddModel(test::SyntheticModel("a", 1, 20, 1));
+  EXPECT_EQ(JournalMode(path), "delete");
+  EXPECT_FALSE(HasLogFiles(path));
+  {
+    const ModelDatabase reader(path, OpenMode::kReadOnly);
+    EXPECT_EQ(reader.LoadModels().size(), 1U);
+    EXPECT_FALSE(HasLogFiles(path));
+    // A writer beside a reader of the finished library logs while it writes and switches back when it closes.
+    std::optional<ModelDatabase> writer(std::in_place, path, OpenMode::kReadWrite);
+    writer->AddModel(test::SyntheticModel("b", 1, 20, 2));
+    EXPECT_TRUE(std::filesystem::exists(path + "-wal"));
+    {
+      const ModelDatabase during(path, OpenMode::kReadOnly);  // opened while logged: holds the log open
+      EXPECT_EQ(during.ListModels().size(), 2U);
+      writer.reset();  // does not wait for it, and leaves the file logged
+      EXPECT_EQ(JournalMode(path), "wal");
+    }
+    EXPECT_EQ(reader.ListModels().size(), 2U);
+  }
+  ModelDatabase(path, OpenMode::kReadWrite).RemoveModel("b");  // the next writer to close switches it
+  EXPECT_EQ(JournalMode(path), "delete");
+  EXPECT_FALSE(HasLogFiles(path));
+}
+
+TEST(MeshSources, ShardsHoldEachModelAndProblemOnceAlikeOnEveryMachine) {
+  // FNV-1a of the name: these values are part of the file layout a cluster's parts were built with.
+  EXPECT_EQ(ShardOfName("003_cracker_box", 3), 1);
+  EXPECT_EQ(ShardOfName("011_banana", 4), 3);
+  EXPECT_EQ(ShardOfName("anything", 1), 0);
+  MeshSourceScan scan;
+  for (int i = 0; i < 60; ++i) scan.sources.push_back(ModelSource{"model_" + std::to_string(i), "m.obj"});
+  for (int i = 0; i < 6; ++i) scan.problems.push_back("folder_" + std::to_string(i) + ": no mesh");
+  std::map<std::string, int> sources, problems;
+  for (int part = 0; part < 3; ++part) {
+    MeshSourceScan kept = scan;
+    KeepShard(part, 3, &kept);
+    EXPECT_GE(kept.sources.size(), 10U) << "part " << part << " of an even split of 60";
+    for (const ModelSource& source : kept.sources) ++sources[source.name];
+    for (const std::string& problem : kept.problems) ++problems[problem];
+  }
+  EXPECT_EQ(sources.size(), 60U);
+  EXPECT_EQ(problems.size(), 6U);
+  for (const auto& [name, count] : sources) EXPECT_EQ(count, 1) << name;
+  for (const auto& [problem, count] : problems) EXPECT_EQ(count, 1) << problem;
+}
+
+TEST(LibraryMerge, CopiesEveryModelInNameOrderWithItsColourMatrixAsOneBuildWould) {
+  const test::TemporaryDirectory directory;
+  const std::string first = directory.File("part0.sqlite"), second = directory.File("part1.sqlite");
+  const std::vector<ModelRecord> models = {test::SyntheticModel("a", 2, 40, 1), test::SyntheticModel("b", 1, 30, 2),
+                                           test::SyntheticModel("c", 3, 20, 3), test::SyntheticModel("d", 1, 50, 4)};
+  ColorMatrixRecord matrix;
+  matrix.model_to_scene << 0.9, 0.1, 0.0, 0.05, 1.1, -0.02, 0.0, 0.0, 0.8;
+  matrix.rms = 0.02;
+  matrix.source = "fit";
+  {
+    ModelDatabase part(first, OpenMode::kCreate);
+    part.AddModel(models[3]);
+    part.AddModel(models[1]);
+    ModelDatabase other(second, OpenMode::kCreate);
+    other.AddModel(models[2]);
+    other.AddModel(models[0]);
+    other.SetColorMatrix("c", matrix);
+  }
+  std::vector<std::string> said;
+  LibraryMergeReporter reporter;
+  reporter.copied = [&](const std::string& model, const std::string& shard, int number, int count) {
+    said.push_back(model + " " + std::filesystem::path(shard).filename().string() + " " + std::to_string(number) + "/" +
+                   std::to_string(count));
+  };
+  const std::string merged = directory.File("merged.sqlite");
+  EXPECT_EQ(MergeLibraries(merged, {first, second}, reporter), 4);
+  EXPECT_THAT(said, ::testing::ElementsAre("a part1.sqlite 1/4", "b part0.sqlite 2/4", "c part1.sqlite 3/4",
+                                           "d part0.sqlite 4/4"));
+  const ModelDatabase library(merged, OpenMode::kReadOnly);
+  const std::vector<ModelSummary> listed = library.ListModels();
+  ASSERT_EQ(listed.size(), 4U);
+  const std::vector<StoredModel> loaded = library.LoadModels();
+  for (size_t i = 0; i < models.size(); ++i) {
+    EXPECT_EQ(listed[i].id, static_cast<int64_t>(i) + 1) << "numbered in name order, as one build of a folder";
+    EXPECT_EQ(listed[i].descriptor_sha256, models[i].DescriptorSha256());
+    EXPECT_EQ(listed[i].mesh_sha256, models[i].mesh_sha256);
+    EXPECT_EQ(test::CompareViews(models[i].views, loaded[i].record.views), "") << models[i].name;
+  }
+  const ColorMatrixRecord copied = library.GetColorMatrix("c").value();
+  EXPECT_EQ(copied.model_to_scene, matrix.model_to_scene);
+  EXPECT_EQ(copied.created, ModelDatabase(second, OpenMode::kReadOnly).GetColorMatrix("c")->created);
+  EXPECT_FALSE(library.GetColorMatrix("a").has_value());
+  EXPECT_TRUE(library.Verify().ok());
+  EXPECT_EQ(JournalMode(merged), "delete");
+}
+
+TEST(LibraryMerge, RefusesMixedSettingsAModelInTwoPartsAndItselfBeforeWritingAnything) {
+  const test::TemporaryDirectory directory;
+  const std::string first = directory.File("part0.sqlite"), second = directory.File("part1.sqlite");
+  const std::string other_settings = directory.File("other.sqlite");
+  ModelDatabase(first, OpenMode::kCreate).AddModel(test::SyntheticModel("a", 1, 20, 1));
+  ModelDatabase(second, OpenMode::kCreate).AddModel(test::SyntheticModel("a", 1, 20, 2));
+  ModelRecord unbinned = test::SyntheticModel("b", 1, 20, 3);
+  unbinned.features.descriptor.soft_binning = false;
+  ModelDatabase(other_settings, OpenMode::kCreate).AddModel(unbinned);
+  const std::string merged = directory.File("merged.sqlite");
+  EXPECT_THAT(InputErrorOf([&] {
+                MergeLibraries(merged, {first, other_settings});
+              }),
+              AllOf(HasSubstr(other_settings), HasSubstr("feature settings"), HasSubstr(first)));
+  EXPECT_THAT(InputErrorOf([&] {
+                MergeLibraries(merged, {first, second});
+              }),
+              AllOf(HasSubstr(second), HasSubstr("\"a\""), HasSubstr("also in " + first)));
+  EXPECT_THAT(InputErrorOf([&] { MergeLibraries(first, {first, second}); }), HasSubstr("other than the merged one"));
+  EXPECT_THAT(InputErrorOf([&] { MergeLibraries(merged, {directory.File("gone.sqlite")}); }),
+              HasSubstr("no such model library"));
+  EXPECT_FALSE(std::filesystem::exists(merged));
+  EXPECT_EQ(ModelDatabase(first, OpenMode::kReadOnly).ListModels().size(), 1U);
 }
 
 }  // namespace

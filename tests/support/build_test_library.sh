@@ -7,7 +7,7 @@ set -euo pipefail
 [ $# -eq 5 ] || { echo "usage: build_test_library.sh demo|ycbv ECVPOSE SOURCE_DIR DATA_DIR OUT.sqlite" >&2; exit 2; }
 kind=$1 ecvpose=$2 source=$3 data=$4 out=$5
 mkdir -p "$(dirname "$out")"
-rm -f "$out" "$out.partial"
+rm -f "$out" "$out-wal" "$out-shm" "$out.partial"
 case $kind in
   # The demo library as scripts/demo builds it; the 7 textured YCB models as recognize_bench reads them.
   demo) "$ecvpose" modeldb build "$source/models/meshes" --views 40 --distance 0.9 --db "$out.partial" ;;
