@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <memory>
 
 #include "app/commands.h"
@@ -14,8 +15,10 @@
 #include "io/frame_io.h"
 #include "io/pose_io.h"
 #include "modeldb/model_library.h"
+#include "recognize/bop_evaluation.h"
 #include "recognize/evaluation.h"
 #include "recognize/recognition_json.h"
+#include "render/renderer.h"
 
 namespace ecv::app {
 namespace {
@@ -28,10 +31,12 @@ struct EvalArgs {
   std::string gt_ycbv;
   std::string out_markdown;
   std::string out_json;
+  std::string metric = "add";
+  std::string models_info;  // BOP models_info.json: the symmetries of --metric bop
 };
 
-// One detections JSON against the ground truth of one frame.
-std::vector<FrameEvaluation> EvaluateOneFrame(const EvalArgs& args, const std::vector<EvalModel>& models) {
+// The detections JSON of one frame, each naming a model of the library.
+std::vector<Detection> ReadFrameDetections(const EvalArgs& args, const std::vector<EvalModel>& models) {
   const std::vector<Detection> detections = DetectionsFromJson(ReadJsonFile(args.detections), args.detections);
   for (size_t i = 0; i < detections.size(); ++i) {
     const bool known = std::any_of(models.begin(), models.end(),
@@ -41,11 +46,44 @@ std::vector<FrameEvaluation> EvaluateOneFrame(const EvalArgs& args, const std::v
                       "a model of the library " + args.db, "'" + detections[i].model + "'");
     }
   }
-  const LoadedFrame frame = app::LoadFrameWithWarnings(args.frame);
+  return detections;
+}
+
+LoadedFrame LoadFrameWithTruth(const FrameSpec& spec) {
+  LoadedFrame frame = app::LoadFrameWithWarnings(spec);
   if (frame.ground_truth.empty()) {
     ThrowInputError(frame.rgbd.name, "ground truth", "a frame with ground-truth poses (YCB-Video prefix or BOP image)");
   }
+  return frame;
+}
+
+// One detections JSON against the ground truth of one frame.
+std::vector<FrameEvaluation> EvaluateOneFrame(const EvalArgs& args, const std::vector<EvalModel>& models) {
+  const std::vector<Detection> detections = ReadFrameDetections(args, models);
+  const LoadedFrame frame = LoadFrameWithTruth(args.frame);
   return {EvaluateFrame(frame.rgbd.name, detections, frame.ground_truth, models)};
+}
+
+// BOP's average recall of one frame's detections: VSD from depth rendered at each pose, MSSD and MSPD over the
+// symmetries of --models-info.
+int EvaluateOneFrameBop(const EvalArgs& args, const ModelLibrary& library, const std::vector<EvalModel>& models) {
+  const std::vector<Detection> detections = ReadFrameDetections(args, models);
+  const LoadedFrame frame = LoadFrameWithTruth(args.frame);
+  std::map<std::string, std::vector<Eigen::Isometry3d>> symmetries;
+  if (!args.models_info.empty()) symmetries = ReadBopSymmetries(args.models_info, library);
+  Renderer renderer;
+  BopJudge judge(library, models, symmetries, renderer);
+  const std::vector<BopObjectErrors> objects = judge.FrameErrors(frame.rgbd, detections, frame.ground_truth);
+  std::map<std::string, std::vector<BopObjectErrors>> by_model;
+  for (size_t i = 0; i < objects.size(); ++i) by_model[judge.judged_models()[i]].push_back(objects[i]);
+  const int width = frame.rgbd.camera.width;
+  std::string table = frame.rgbd.name + ": BOP average recall (VSD, MSSD, MSPD; symmetries " +
+                      (args.models_info.empty() ? std::string("none: no --models-info") : "of " + args.models_info) +
+                      ")\n\n" + BopRecallMarkdown(by_model, width);
+  std::cout << table;
+  if (!args.out_markdown.empty()) WriteFileAtomically(args.out_markdown, table);
+  if (!args.out_json.empty()) WriteJsonFile(args.out_json, BopRecallJson(by_model, width));
+  return kExitOk;
 }
 
 int RunEval(const EvalArgs& args) {
@@ -59,6 +97,17 @@ int RunEval(const EvalArgs& args) {
   load.build_matchers = false;
   const ModelLibrary library = ModelLibrary::Load(args.db, load);
   const std::vector<EvalModel> models = EvalModels(library);
+  if (args.metric == "bop") {
+    if (args.frame.positional.empty()) {
+      std::cerr << "ecvpose eval: --metric bop takes one FRAME (the folder forms judge by ADD only)\n";
+      return kExitBadUsage;
+    }
+    return EvaluateOneFrameBop(args, library, models);
+  }
+  if (!args.models_info.empty()) {
+    std::cerr << "ecvpose eval: --models-info is for --metric bop\n";
+    return kExitBadUsage;
+  }
 
   std::vector<FrameEvaluation> frames;
   if (!args.frame.positional.empty()) {
@@ -86,10 +135,20 @@ CommandAction SetupEvalCommand(CLI::App& command) {
       ->required();
   AddDbOption(command, &args->db, "The model library the detections came from (meshes, diameters)");
   command.add_option("FRAME", args->frame.positional, "YCB-Video prefix or BOP SCENE_DIR:IMAGE_ID with ground truth");
+  command.add_option("--depth", args->frame.depth_path,
+                     "16-bit depth PNG replacing the FRAME's (a BOP image's; --metric bop's VSD reads the depth)");
   command.add_option("--gt-bop", args->gt_bop, "BOP scene folder: ground truth from its scene_gt.json");
   command.add_option("--gt-ycbv", args->gt_ycbv, "YCB-Video video folder: ground truth from each frame's -meta.mat");
   command.add_option("--out-md", args->out_markdown, "The tables as a markdown file");
   command.add_option("--out-json", args->out_json, "Per frame and object numbers (metres, radians) and totals");
+  command
+      .add_option("--metric", args->metric,
+                  "add: recall at ADD (ADD-S) < 0.1 d with false positives; bop: the BOP challenge's average recall "
+                  "(VSD, MSSD, MSPD; one FRAME)")
+      ->check(CLI::IsMember({"add", "bop"}))
+      ->capture_default_str();
+  command.add_option("--models-info", args->models_info,
+                     "BOP models_info.json (millimetres): each object's symmetries for --metric bop (default: none)");
   command.footer(
       "Per object: rotation and translation error, ADD, ADD-S, and correct when ADD (ADD-S for symmetric models)\n"
       "is below 0.1 x diameter; then recall and false positives, overall and per model. With --gt-bop/--gt-ycbv,\n"

@@ -20,9 +20,11 @@
 #include "modeldb/model_library.h"
 #include "modeldb/sql.h"
 #include "recognize/acceptance.h"
+#include "recognize/bop_evaluation.h"
 #include "recognize/evaluation.h"
 #include "recognize/recognition_json.h"
 #include "recognize/recognizer.h"
+#include "render/renderer.h"
 #include "support/demo_library.h"
 #include "support/test_data.h"
 #include "verify_prior.h"
@@ -830,6 +832,51 @@ TEST_F(RecognizeEndToEnd, AMigratedLibraryKeepsItsRowsAndGetsThePointPairsOfAFre
     EXPECT_EQ(found[0][d].model, found[1][d].model);
     EXPECT_TRUE(found[0][d].camera_from_object.isApprox(found[1][d].camera_from_object, 1e-12)) << found[0][d].model;
   }
+}
+
+// BOP's average recall on the demo frame: its ground truth as detections recalls every instance at every threshold;
+// a pose 2 cm off loses the MSSD thresholds below 2 cm, and a second, worse detection of a single instance is not
+// counted (BOP takes as many estimates as instances).
+TEST_F(RecognizeEndToEnd, BopRecallOfTheGroundTruthIsOneAndOfAShiftedPoseFollowsTheShift) {
+  const ModelLibrary library = Library();
+  const std::vector<EvalModel> models = EvalModels(library);
+  const LoadedFrame frame = LoadYcbvFrame(Frame());
+  std::vector<Detection> detections;  // the three objects of the four that are in the library
+  for (const GroundTruth& gt : frame.ground_truth) {
+    if (library.Find(gt.object_name) == nullptr) continue;
+    Detection detection;
+    detection.model = gt.object_name;
+    detection.score = 0.9;
+    detection.camera_from_object = gt.camera_from_object;
+    detections.push_back(detection);
+  }
+  Renderer renderer;
+  BopJudge judge(library, models, {}, renderer);
+  ASSERT_EQ(detections.size(), 3U);
+  const std::vector<BopObjectErrors> exact = judge.FrameErrors(frame.rgbd, detections, frame.ground_truth);
+  ASSERT_EQ(exact.size(), 3U);
+  const BopRecall all = AverageRecall(exact, frame.rgbd.camera.width);
+  EXPECT_EQ(all.instances, 3);
+  EXPECT_DOUBLE_EQ(all.ar, 1.0);
+
+  Detection shifted = detections[0];
+  shifted.camera_from_object.pretranslate(Eigen::Vector3d(0.02, 0.0, 0.0));
+  Detection worse = detections[0];
+  worse.score = 0.1;
+  worse.camera_from_object.pretranslate(Eigen::Vector3d(0.0, 0.3, 0.0));
+  const std::vector<BopObjectErrors> off =
+      judge.FrameErrors(frame.rgbd, {worse, shifted, detections[1], detections[2]}, frame.ground_truth);
+  const std::string& name = detections[0].model;
+  const auto index =
+      std::find(judge.judged_models().begin(), judge.judged_models().end(), name) - judge.judged_models().begin();
+  const BopObjectErrors& object = off[static_cast<size_t>(index)];
+  ASSERT_EQ(object.errors.size(), 1U) << "one instance: only the best-scoring estimate";
+  EXPECT_NEAR(object.errors[0][0].mssd_m, 0.02, 1e-9);
+  int above = 0;
+  for (const double fraction : BopFractions()) above += 0.02 < fraction * object.diameter_m ? 1 : 0;
+  EXPECT_NEAR(AverageRecall({object}, frame.rgbd.camera.width).ar_mssd, above / 10.0, 1e-12);
+  EXPECT_GT(object.errors[0][0].vsd.front(), 0.1) << "2 cm is over the smallest tau of its visible surface";
+  EXPECT_DOUBLE_EQ(AverageRecall(judge.FrameErrors(frame.rgbd, {}, frame.ground_truth), 640).ar, 0.0);
 }
 
 }  // namespace
