@@ -64,20 +64,44 @@ std::vector<FrameEvaluation> EvaluateOneFrame(const EvalArgs& args, const std::v
   return {EvaluateFrame(frame.rgbd.name, detections, frame.ground_truth, models)};
 }
 
-// BOP's average recall of one frame's detections: VSD from depth rendered at each pose, MSSD and MSPD over the
-// symmetries of --models-info.
-int EvaluateOneFrameBop(const EvalArgs& args, const ModelLibrary& library, const std::vector<EvalModel>& models) {
-  const std::vector<Detection> detections = ReadFrameDetections(args, models);
-  const LoadedFrame frame = LoadFrameWithTruth(args.frame);
+// BOP's average recall of the detections of one frame or of a folder's frames: VSD from depth rendered at each pose,
+// MSSD and MSPD over the symmetries of --models-info; a table per model and over all.
+int EvaluateBop(const EvalArgs& args, const ModelLibrary& library, const std::vector<EvalModel>& models) {
+  std::vector<FolderFrame> frames;
+  if (!args.frame.positional.empty()) {
+    FolderFrame frame;
+    frame.frame = args.frame.positional;
+    frame.detections = ReadFrameDetections(args, models);
+    frames.push_back(std::move(frame));
+  } else {
+    const bool ycbv = !args.gt_ycbv.empty();
+    frames = ReadFolderDetections(args.detections, ycbv ? GroundTruthFolder::kYcbVideo : GroundTruthFolder::kBopScene,
+                                  ycbv ? args.gt_ycbv : args.gt_bop, models);
+  }
   std::map<std::string, std::vector<Eigen::Isometry3d>> symmetries;
   if (!args.models_info.empty()) symmetries = ReadBopSymmetries(args.models_info, library);
   Renderer renderer;
   BopJudge judge(library, models, symmetries, renderer);
-  const std::vector<BopObjectErrors> objects = judge.FrameErrors(frame.rgbd, detections, frame.ground_truth);
   std::map<std::string, std::vector<BopObjectErrors>> by_model;
-  for (size_t i = 0; i < objects.size(); ++i) by_model[judge.judged_models()[i]].push_back(objects[i]);
-  const int width = frame.rgbd.camera.width;
-  std::string table = frame.rgbd.name + ": BOP average recall (VSD, MSSD, MSPD; symmetries " +
+  int width = 0;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    FrameSpec spec = args.frame;
+    spec.positional = frames[i].frame;
+    const LoadedFrame frame = LoadFrameWithTruth(spec);
+    if (width != 0 && frame.rgbd.camera.width != width) {
+      ThrowInputError(frame.rgbd.name, "image width", "that of the other frames, " + std::to_string(width),
+                      std::to_string(frame.rgbd.camera.width));
+    }
+    width = frame.rgbd.camera.width;
+    const std::vector<BopObjectErrors> objects =
+        judge.FrameErrors(frame.rgbd, frames[i].detections, frame.ground_truth);
+    for (size_t k = 0; k < objects.size(); ++k) by_model[judge.judged_models()[k]].push_back(objects[k]);
+    if (frames.size() > 1) std::cerr << "eval: [" << i + 1 << "/" << frames.size() << "] " << frames[i].frame << '\n';
+  }
+  const std::string source = args.frame.positional.empty() ? std::to_string(frames.size()) + " frames of " +
+                                                                 (args.gt_ycbv.empty() ? args.gt_bop : args.gt_ycbv)
+                                                           : frames.front().frame;
+  std::string table = source + ": BOP average recall (VSD, MSSD, MSPD; symmetries " +
                       (args.models_info.empty() ? std::string("none: no --models-info") : "of " + args.models_info) +
                       ")\n\n" + BopRecallMarkdown(by_model, width);
   std::cout << table;
@@ -97,13 +121,7 @@ int RunEval(const EvalArgs& args) {
   load.build_matchers = false;
   const ModelLibrary library = ModelLibrary::Load(args.db, load);
   const std::vector<EvalModel> models = EvalModels(library);
-  if (args.metric == "bop") {
-    if (args.frame.positional.empty()) {
-      std::cerr << "ecvpose eval: --metric bop takes one FRAME (the folder forms judge by ADD only)\n";
-      return kExitBadUsage;
-    }
-    return EvaluateOneFrameBop(args, library, models);
-  }
+  if (args.metric == "bop") return EvaluateBop(args, library, models);
   if (!args.models_info.empty()) {
     std::cerr << "ecvpose eval: --models-info is for --metric bop\n";
     return kExitBadUsage;
@@ -135,8 +153,9 @@ CommandAction SetupEvalCommand(CLI::App& command) {
       ->required();
   AddDbOption(command, &args->db, "The model library the detections came from (meshes, diameters)");
   command.add_option("FRAME", args->frame.positional, "YCB-Video prefix or BOP SCENE_DIR:IMAGE_ID with ground truth");
-  command.add_option("--depth", args->frame.depth_path,
-                     "16-bit depth PNG replacing the FRAME's (a BOP image's; --metric bop's VSD reads the depth)");
+  command.add_option(
+      "--depth", args->frame.depth_path,
+      "16-bit depth PNG replacing the FRAME's (a BOP image's; --metric bop's VSD reads the frames' depth)");
   command.add_option("--gt-bop", args->gt_bop, "BOP scene folder: ground truth from its scene_gt.json");
   command.add_option("--gt-ycbv", args->gt_ycbv, "YCB-Video video folder: ground truth from each frame's -meta.mat");
   command.add_option("--out-md", args->out_markdown, "The tables as a markdown file");
@@ -144,7 +163,7 @@ CommandAction SetupEvalCommand(CLI::App& command) {
   command
       .add_option("--metric", args->metric,
                   "add: recall at ADD (ADD-S) < 0.1 d with false positives; bop: the BOP challenge's average recall "
-                  "(VSD, MSSD, MSPD; one FRAME)")
+                  "(VSD, MSSD, MSPD)")
       ->check(CLI::IsMember({"add", "bop"}))
       ->capture_default_str();
   command.add_option("--models-info", args->models_info,
@@ -152,7 +171,8 @@ CommandAction SetupEvalCommand(CLI::App& command) {
   command.footer(
       "Per object: rotation and translation error, ADD, ADD-S, and correct when ADD (ADD-S for symmetric models)\n"
       "is below 0.1 x diameter; then recall and false positives, overall and per model. With --gt-bop/--gt-ycbv,\n"
-      "frames of the folder without a line in the detections (or with an \"error\" line) count as missed.");
+      "frames of the folder without a line in the detections (or with an \"error\" line) count as missed.\n"
+      "--metric bop: the BOP challenge's average recall per model and over all (docs/bop.md).");
   return [args] { return RunEval(*args); };
 }
 

@@ -90,4 +90,17 @@ enum class GroundTruthFolder {
 std::vector<FrameEvaluation> EvaluateDetectionsFile(const std::string& detections_path, GroundTruthFolder kind,
                                                     const std::string& folder, const std::vector<EvalModel>& models);
 
+/// One frame of a ground-truth folder with the detections a file holds for it.
+struct FolderFrame {
+  std::string frame;  ///< as LoadFrame takes it: "DIR/000001" (YCB-Video) or "DIR:3" (BOP)
+  std::vector<Detection> detections;
+  std::vector<GroundTruth> ground_truth;
+  std::string missed;  ///< why it has no detections to judge (see FrameEvaluation::missed); empty when judged
+};
+
+/// The frames of a folder with their detections and ground truth, read and checked as EvaluateDetectionsFile reads
+/// them, in the folder's order.
+std::vector<FolderFrame> ReadFolderDetections(const std::string& detections_path, GroundTruthFolder kind,
+                                              const std::string& folder, const std::vector<EvalModel>& models);
+
 }  // namespace ecv

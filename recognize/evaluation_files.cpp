@@ -8,6 +8,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <utility>
 
 #include "core/error.h"
 #include "io/frame_io.h"
@@ -273,8 +274,8 @@ bool IsCsv(const std::string& path) {
 
 }  // namespace
 
-std::vector<FrameEvaluation> EvaluateDetectionsFile(const std::string& detections_path, GroundTruthFolder kind,
-                                                    const std::string& folder, const std::vector<EvalModel>& models) {
+std::vector<FolderFrame> ReadFolderDetections(const std::string& detections_path, GroundTruthFolder kind,
+                                              const std::string& folder, const std::vector<EvalModel>& models) {
   TruthFolder truth = ListTruthFolder(kind, folder);
   if (!fs::is_regular_file(detections_path)) {
     ThrowInputError(detections_path, "--detections", "a JSON Lines or BOP CSV file", "no such file");
@@ -291,19 +292,31 @@ std::vector<FrameEvaluation> EvaluateDetectionsFile(const std::string& detection
   if (truth.frames.empty()) {
     ThrowInputError(folder, "frames", "images of scene_gt.json with an rgb/ image, or detections naming some", "none");
   }
-  std::vector<FrameEvaluation> evaluations;
+  std::vector<FolderFrame> frames;
   for (const auto& [number, frame] : truth.frames) {
-    const std::vector<GroundTruth> ground_truth =
+    FolderFrame folder_frame;
+    folder_frame.frame = frame;
+    folder_frame.ground_truth =
         kind == GroundTruthFolder::kYcbVideo ? LoadYcbvFrame(frame).ground_truth : ReadBopGroundTruth(folder, number);
     const auto found = detections.find(number);
-    const bool judged = found != detections.end() && found->second.error.empty();
-    evaluations.push_back(
-        EvaluateFrame(frame, judged ? found->second.detections : std::vector<Detection>{}, ground_truth, models));
     if (found == detections.end()) {
-      evaluations.back().missed = "no line in the detections";
-    } else if (!judged) {
-      evaluations.back().missed = "recognize failed: " + found->second.error;
+      folder_frame.missed = "no line in the detections";
+    } else if (!found->second.error.empty()) {
+      folder_frame.missed = "recognize failed: " + found->second.error;
+    } else {
+      folder_frame.detections = found->second.detections;
     }
+    frames.push_back(std::move(folder_frame));
+  }
+  return frames;
+}
+
+std::vector<FrameEvaluation> EvaluateDetectionsFile(const std::string& detections_path, GroundTruthFolder kind,
+                                                    const std::string& folder, const std::vector<EvalModel>& models) {
+  std::vector<FrameEvaluation> evaluations;
+  for (const FolderFrame& frame : ReadFolderDetections(detections_path, kind, folder, models)) {
+    evaluations.push_back(EvaluateFrame(frame.frame, frame.detections, frame.ground_truth, models));
+    evaluations.back().missed = frame.missed;
   }
   return evaluations;
 }
