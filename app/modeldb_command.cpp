@@ -1,7 +1,6 @@
 // `ecvpose modeldb`: build a model library from meshes into SQLite, and list, inspect, remove, verify, export
 // and migrate it. Compiled only into the ecvpose executable; reads flags into options and calls ecv_modeldb.
 
-#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <iostream>

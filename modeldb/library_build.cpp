@@ -1,6 +1,5 @@
 #include "modeldb/library_build.h"
 
-#include <algorithm>
 #include <exception>
 #include <filesystem>
 #include <map>
@@ -68,12 +67,13 @@ int MergeLibraries(const std::string& out_path, const std::vector<std::string>& 
     const std::string shard_settings = SettingsText(shards.back());
     if (!shard_settings.empty() && !settings.empty() && shard_settings != settings) {
       ThrowInputError(path, "feature settings",
-                      "those of " + settings_from +
-                          ": shards of one library are built "
-                          "with the same settings",
+                      "those of " + settings_from + ": the parts of one library are built with the same settings",
                       shard_settings);
     }
-    if (settings.empty()) settings = shard_settings, settings_from = path;
+    if (settings.empty()) {
+      settings = shard_settings;
+      settings_from = path;
+    }
     for (const ModelSummary& model : shards.back().ListModels()) {
       const auto [place, added] = shard_of_model.emplace(model.name, shards.size() - 1);
       if (!added) {

@@ -413,6 +413,13 @@ TEST_F(ModeldbCli, BadUsageExitsWithTwo) {
       test::RunCli("modeldb build " + test::DemoMeshDirectory() + " --name x --db " + scratch_.File("x.sqlite"));
   EXPECT_EQ(name.exit_code, 2);
   EXPECT_THAT(name.output, HasSubstr("--name needs a single mesh"));
+  EXPECT_EQ(test::RunCli("modeldb merge " + scratch_.File("merged.sqlite")).exit_code, 2) << "no parts";
+  for (const char* const shard : {"3/3", "1", "-1/2", "1/0", "0/2x"}) {  // a bad value, as of --size: exit 1
+    const test::CommandResult bad = test::RunCli("modeldb build " + test::DemoMeshDirectory() + " --shard " + shard +
+                                                 " --db " + scratch_.File("x.sqlite"));
+    EXPECT_EQ(bad.exit_code, 1) << shard;
+    EXPECT_THAT(bad.output, AllOf(HasSubstr("--shard"), HasSubstr("0 <= I < N"))) << shard;
+  }
 }
 
 }  // namespace
