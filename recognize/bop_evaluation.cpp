@@ -43,8 +43,9 @@ BopJudge::BopJudge(const ModelLibrary& library, std::vector<EvalModel> models,
 
 cv::Mat BopJudge::RenderDepth(const std::string& model, const PinholeCamera& camera, const Eigen::Isometry3d& pose) {
   auto mesh = meshes_.find(model);
-  const LibraryModel* found = library_.Find(model);
-  if (mesh == meshes_.end()) mesh = meshes_.emplace(model, renderer_.AddMesh(ModelMesh(found->record, false))).first;
+  if (mesh == meshes_.end()) {
+    mesh = meshes_.emplace(model, renderer_.AddMesh(ModelMesh(library_.Find(model)->record, false))).first;
+  }
   return renderer_.Render(mesh->second, camera, pose).depth;
 }
 
