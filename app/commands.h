@@ -42,6 +42,7 @@ CommandAction SetupColorcalCommand(CLI::App& command);  // colorcal/colorcal_com
 CommandAction SetupRecognizeCommand(CLI::App& command, FrameSourceOpener open_live);  // recognize/recognize_command.cpp
 CommandAction SetupServeCommand(CLI::App& command);                                   // recognize/serve_command.cpp
 CommandAction SetupEvalCommand(CLI::App& command);                                    // recognize/eval_command.cpp
+CommandAction SetupBopCommand(CLI::App& command);                                     // app/bop_command.cpp
 CommandAction SetupRecordCommand(CLI::App& command);                                  // camera/camera_command.cpp
 /// Opens openni2:// cameras and .oni recordings as frame sources; nullptr for other sequences (camera_command.cpp).
 std::unique_ptr<FrameSource> OpenCameraSource(const std::string& sequence,

@@ -16,6 +16,7 @@
 #include "io/pose_io.h"
 #include "modeldb/model_library.h"
 #include "recognize/bop_evaluation.h"
+#include "recognize/bop_task.h"
 #include "recognize/evaluation.h"
 #include "recognize/recognition_json.h"
 #include "render/renderer.h"
@@ -49,18 +50,22 @@ std::vector<Detection> ReadFrameDetections(const EvalArgs& args, const std::vect
   return detections;
 }
 
-LoadedFrame LoadFrameWithTruth(const FrameSpec& spec) {
+// The frame and its ground truth, each instance named as the library names its model (a BOP frame's obj_000001 may be
+// the library's 002_master_chef_can).
+LoadedFrame LoadFrameWithTruth(const FrameSpec& spec, const ModelLibrary& library) {
   LoadedFrame frame = app::LoadFrameWithWarnings(spec);
   if (frame.ground_truth.empty()) {
     ThrowInputError(frame.rgbd.name, "ground truth", "a frame with ground-truth poses (YCB-Video prefix or BOP image)");
   }
+  NameTruthAfterModels(ModelOfObject(LibraryObjectIds(library)), &frame.ground_truth);
   return frame;
 }
 
 // One detections JSON against the ground truth of one frame.
-std::vector<FrameEvaluation> EvaluateOneFrame(const EvalArgs& args, const std::vector<EvalModel>& models) {
+std::vector<FrameEvaluation> EvaluateOneFrame(const EvalArgs& args, const ModelLibrary& library,
+                                              const std::vector<EvalModel>& models) {
   const std::vector<Detection> detections = ReadFrameDetections(args, models);
-  const LoadedFrame frame = LoadFrameWithTruth(args.frame);
+  const LoadedFrame frame = LoadFrameWithTruth(args.frame, library);
   return {EvaluateFrame(frame.rgbd.name, detections, frame.ground_truth, models)};
 }
 
@@ -87,7 +92,7 @@ int EvaluateBop(const EvalArgs& args, const ModelLibrary& library, const std::ve
   for (size_t i = 0; i < frames.size(); ++i) {
     FrameSpec spec = args.frame;
     spec.positional = frames[i].frame;
-    const LoadedFrame frame = LoadFrameWithTruth(spec);
+    const LoadedFrame frame = LoadFrameWithTruth(spec, library);
     if (width != 0 && frame.rgbd.camera.width != width) {
       ThrowInputError(frame.rgbd.name, "image width", "that of the other frames, " + std::to_string(width),
                       std::to_string(frame.rgbd.camera.width));
@@ -129,7 +134,7 @@ int RunEval(const EvalArgs& args) {
 
   std::vector<FrameEvaluation> frames;
   if (!args.frame.positional.empty()) {
-    frames = EvaluateOneFrame(args, models);
+    frames = EvaluateOneFrame(args, library, models);
   } else if (!args.gt_ycbv.empty()) {
     frames = EvaluateDetectionsFile(args.detections, GroundTruthFolder::kYcbVideo, args.gt_ycbv, models);
   } else {

@@ -35,6 +35,8 @@ const Subcommand kSubcommands[] = {
      ecv::app::SetupServeCommand},
     {"eval", "Score detections against ground truth: rotation, translation, ADD, ADD-S, recall",
      ecv::app::SetupEvalCommand},
+    {"bop", "Run BOP's localisation task over a dataset (resumable BOP CSV) and print its average recall",
+     ecv::app::SetupBopCommand},
     {"record", "Record an OpenNI2 camera or any frame sequence as an .oni file (lossless), K beside it",
      ecv::app::SetupRecordCommand},
 };

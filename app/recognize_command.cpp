@@ -23,6 +23,7 @@
 #include "io/frame_io.h"
 #include "io/pose_io.h"
 #include "modeldb/model_library.h"
+#include "recognize/bop_task.h"
 #include "recognize/recognition_json.h"
 #include "recognize/recognition_stream.h"
 #include "recognize/recognizer.h"
@@ -40,14 +41,43 @@ struct RecognizeArgs {
   std::string out_json;
   std::string out_bop;
   int scene_id = -1, image_id = -1;
+  std::string targets;  // BOP test_targets_bop19.json
   std::string overlay;
 };
 
-// The BOP obj_id of each model of the library (modeldb list shows them).
-std::map<std::string, int> LibraryObjectIds(const ModelLibrary& library) {
-  std::vector<std::pair<std::string, int64_t>> models;
-  for (const LibraryModel& model : library.models()) models.emplace_back(model.record.name, model.record.id);
-  return BopObjectIds(std::move(models));
+// With --targets: each image's targets by (scene_id, im_id), and the library's model of each BOP object id.
+struct Targets {
+  std::string path;
+  std::map<std::pair<int, int>, BopImage> images;
+  std::map<int, std::string> model_of_object;
+
+  bool active() const { return !path.empty(); }
+
+  // The frame's targets as library model names; an InputError for a frame the file has none for.
+  std::map<std::string, int> Of(std::pair<int, int> ids) const {
+    const auto image = images.find(ids);
+    if (image == images.end()) {
+      ThrowInputError(path, "targets",
+                      "an entry for scene " + std::to_string(ids.first) + " image " + std::to_string(ids.second) +
+                          " (set --scene-id and --image-id)");
+    }
+    return TargetModels(image->second, model_of_object);
+  }
+};
+
+Targets ReadTargets(const std::string& path, const std::map<std::string, int>& object_ids) {
+  Targets targets;
+  if (path.empty()) return targets;
+  targets.path = path;
+  for (BopImage& image : GroupBopTargets(ReadBopTargets(path), path)) targets.images[image.key()] = std::move(image);
+  targets.model_of_object = ModelOfObject(object_ids);
+  return targets;
+}
+
+// The frame recognised as the task asks: the targets alone (BOP's localisation), else every model.
+RecognitionResult RecognizeAsAsked(Recognizer& recognizer, const Targets& targets, const RgbdFrame& frame,
+                                   std::pair<int, int> ids) {
+  return targets.active() ? recognizer.RecognizeTargets(frame, targets.Of(ids)) : recognizer.Recognize(frame);
 }
 
 // Scene and image ids of a frame: from --scene-id and --image-id (a single frame), else as the frame names them (a
@@ -56,20 +86,6 @@ std::pair<int, int> BopIds(const LoadedFrame& frame, int index, int scene_flag =
   if (scene_flag >= 0 && image_flag >= 0) return {scene_flag, image_flag};
   if (frame.scene_id >= 0 && frame.image_id >= 0) return {frame.scene_id, frame.image_id};
   return {0, index};
-}
-
-constexpr const char* kBopHeader = "scene_id,im_id,obj_id,score,R,t,time\n";
-
-// One BOP CSV row per detection: scene_id,im_id,obj_id,score,R (9, row-major),t (mm),time (s).
-void AppendBopRows(std::ostream& out, std::pair<int, int> ids, const RecognitionResult& result,
-                   const std::map<std::string, int>& object_ids) {
-  for (const Detection& d : result.detections) {
-    const Eigen::Matrix3d r = d.camera_from_object.linear();
-    const Eigen::Vector3d t = d.camera_from_object.translation() * 1000.0;
-    out << ids.first << ',' << ids.second << ',' << object_ids.at(d.model) << ',' << d.score << ',';
-    for (int i = 0; i < 9; ++i) out << (i > 0 ? " " : "") << r(i / 3, i % 3);
-    out << ',' << t.x() << ' ' << t.y() << ' ' << t.z() << ',' << result.timings_ms.at("total") / 1000.0 << '\n';
-  }
 }
 
 void PrintDetections(std::ostream& out, const LoadedFrame& loaded, const RecognitionResult& result) {
@@ -86,9 +102,9 @@ void PrintDetections(std::ostream& out, const LoadedFrame& loaded, const Recogni
         << d.edge_pixels << ", fit " << std::setprecision(1) << 1000.0 * d.surface_error_m << " mm"
         << std::setprecision(2) << ", outline " << d.contour_agreement << ", runs on " << d.continuation
         << "), inliers " << d.inlier_fraction << ", view " << d.view << ", "
-        << HypothesisSourceName(d.hypothesis_source) << (d.tracked ? ", tracked" : "") << ", t = ["
-        << std::setprecision(3) << d.camera_from_object.translation().transpose() << "] m" << std::setprecision(2)
-        << '\n';
+        << HypothesisSourceName(d.hypothesis_source) << (d.tracked ? ", tracked" : "")
+        << (d.accepted ? "" : ", not accepted (a target's best)") << ", t = [" << std::setprecision(3)
+        << d.camera_from_object.translation().transpose() << "] m" << std::setprecision(2) << '\n';
     for (const GroundTruth& truth : loaded.ground_truth) {
       if (truth.object_name != d.model) continue;
       out << "    vs ground truth: " << std::setprecision(1)
@@ -117,6 +133,9 @@ RecognizerOptions OptionsFromArgs(const RecognizeArgs& args) {
   if (args.recognizer.stream.search_beside && !args.recognizer.stream.track) {
     ThrowInputError("recognize", "--search-beside", "--track as well");
   }
+  if (!args.targets.empty() && args.recognizer.stream.track) {
+    ThrowInputError("recognize", "--targets", "frames recognised one by one, not --track");
+  }
   return options;
 }
 
@@ -127,15 +146,18 @@ std::ostream& Report(const RecognizeArgs& args) {
 
 int RecognizeOneFrame(const RecognizeArgs& args, const LoadedFrame& loaded, const ModelLibrary& library,
                       Recognizer& recognizer) {
-  const RecognitionResult result = recognizer.Recognize(loaded.rgbd);
+  const std::map<std::string, int> object_ids = LibraryObjectIds(library);
+  const std::pair<int, int> ids = BopIds(loaded, 0, args.scene_id, args.image_id);
+  const RecognitionResult result =
+      RecognizeAsAsked(recognizer, ReadTargets(args.targets, object_ids), loaded.rgbd, ids);
   PrintDetections(Report(args), loaded, result);
   const std::string json = RecognitionToJson(result).dump(2) + "\n";
   if (args.out_json == "-") LineOutput("-", "--out-json").Write(json);
   if (!args.out_json.empty() && args.out_json != "-") WriteFileAtomically(args.out_json, json);
   if (!args.out_bop.empty()) {
     std::ostringstream csv;
-    csv << kBopHeader;
-    AppendBopRows(csv, BopIds(loaded, 0, args.scene_id, args.image_id), result, LibraryObjectIds(library));
+    csv << kBopCsvHeader;
+    WriteBopRows(csv, ids, result.detections, object_ids, result.timings_ms.at("total") / 1000.0);
     if (args.out_bop == "-") {
       LineOutput("-", "--out-bop").Write(csv.str());
     } else {
@@ -159,8 +181,9 @@ int RecognizeSequence(const RecognizeArgs& args, FrameSource& feed, const ModelL
                       const RecognizerOptions& search_options) {
   std::ostream& report = Report(args);
   LineOutput lines(args.out_json, "--out-json"), csv(args.out_bop, "--out-bop");
-  if (csv.active()) csv.Write(kBopHeader);
+  if (csv.active()) csv.Write(kBopCsvHeader);
   const std::map<std::string, int> object_ids = LibraryObjectIds(library);
+  const Targets targets = ReadTargets(args.targets, object_ids);
   int done = 0, failed = 0;
   double total_ms = 0.0;
   RecognitionStream stream(recognizer, args.recognizer.stream, MakeRecognizerFactory(library, search_options));
@@ -168,7 +191,9 @@ int RecognizeSequence(const RecognizeArgs& args, FrameSource& feed, const ModelL
   while (const std::optional<std::string> frame = feed.Next()) {
     try {
       const LoadedFrame loaded = feed.Load();
-      const RecognitionResult result = stream.Next(loaded.rgbd);
+      const std::pair<int, int> ids = BopIds(loaded, done + failed);
+      const RecognitionResult result =
+          targets.active() ? RecognizeAsAsked(recognizer, targets, loaded.rgbd, ids) : stream.Next(loaded.rgbd);
       total_ms += result.timings_ms.at("total");
       report << feed.Counter();
       if (feed.Skipped() > 0) report << "(" << feed.Skipped() << " older frames skipped) ";
@@ -185,7 +210,7 @@ int RecognizeSequence(const RecognizeArgs& args, FrameSource& feed, const ModelL
       if (lines.active()) lines.Write(line.dump() + "\n");
       if (csv.active()) {
         std::ostringstream rows;
-        AppendBopRows(rows, BopIds(loaded, done + failed), result, object_ids);
+        WriteBopRows(rows, ids, result.detections, object_ids, result.timings_ms.at("total") / 1000.0);
         csv.Write(rows.str());
       }
       ++done;
@@ -278,6 +303,11 @@ CommandAction SetupRecognizeCommand(CLI::App& command, FrameSourceOpener open_li
   command.add_option("--image-id", args->image_id,
                      "BOP image id of a single frame (default: as the frame names it, else its place in the\n"
                      "sequence from 0)");
+  command.add_option("--targets", args->targets,
+                     "BOP's localisation task: a test_targets_bop19.json; in each frame (its scene and image ids as\n"
+                     "for --out-bop) only its target objects are looked for, each reporting up to its inst_count\n"
+                     "estimates, the best by score, without a threshold (a pose the acceptance rejected comes last,\n"
+                     "\"accepted\": false)");
   command.add_option("--overlay", args->overlay,
                      "Picture: each detected model in red with its name (PNG); with --sequence a directory,\n"
                      "one DIR/0001.png ... per frame in sequence order, written before the frame's --out-json\n"

@@ -51,6 +51,9 @@ struct Detection {
   /// Where its pose came from: kContext (view ranking and RANSAC) or kPpf (point pair features); a tracked
   /// detection keeps its first detection's.
   HypothesisSource hypothesis_source = HypothesisSource::kContext;
+  /// False for a pose the acceptance rejected that is reported all the same: the best a target model had
+  /// (Recognizer::RecognizeTargets).
+  bool accepted = true;
 };
 
 /// A pose the acceptance (min_score, min_visible_fraction) judged, with its evidence, and the verdict.

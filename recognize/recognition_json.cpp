@@ -30,6 +30,7 @@ nlohmann::json DetectionToJson(const Detection& d) {
                          {"confirmed", d.confirmed},
                          {"hypothesis", HypothesisSourceName(d.hypothesis_source)}};
   if (d.acceptance >= 0.0) json["acceptance"] = d.acceptance;
+  if (!d.accepted) json["accepted"] = false;  // a target's best rejected pose (recognize --targets)
   return json;
 }
 
@@ -76,6 +77,10 @@ std::vector<Detection> DetectionsFromJson(const nlohmann::json& json, const std:
         ThrowInputError(source, field + ".hypothesis", "\"context\" or \"ppf\"", hypothesis.dump());
       }
       detection.hypothesis_source = ParseHypothesisSource(hypothesis.get<std::string>(), source + " " + field);
+    }
+    if (item.contains("accepted")) {
+      if (!item["accepted"].is_boolean()) ThrowInputError(source, field + ".accepted", "true or false");
+      detection.accepted = item["accepted"].get<bool>();
     }
     detections.push_back(detection);
   }

@@ -140,7 +140,10 @@ class Recognizer::Impl {
   }
 
   // Follow the priors, choose the models to search, search each (one per worker), suppress overlaps.
-  RecognitionResult Recognize(const RgbdFrame& frame, const std::vector<Detection>& priors, SearchScope scope) {
+  // With `targets` (model name -> instances), only those models are searched, each for its instances, and each
+  // reports its best rejected pose when it found fewer (RecognizeTargets).
+  RecognitionResult Recognize(const RgbdFrame& frame, const std::vector<Detection>& priors, SearchScope scope,
+                              const std::map<std::string, int>* targets = nullptr) {
     frame.Check();
     const Clock::time_point start = Clock::now();
     RecognitionResult result;
@@ -148,12 +151,20 @@ class Recognizer::Impl {
     Scene scene = PrepareScene(frame, options_);
     if (options_.keep_verified) scene.verified_log = std::make_unique<Scene::VerifiedLog>();
     std::vector<ModelInFrame> models = AssignPriors(priors, model_names_, options_.tracking);
+    for (size_t m = 0; m < models.size(); ++m) {
+      models[m].max_instances = targets ? TargetCount(*targets, model_names_[m]) : options_.max_instances;
+    }
     if (!priors.empty()) {
       const Clock::time_point stage = Clock::now();
       FollowPriors(scene, &models);
       times.Add(Stage::kTrack, MillisecondsSince(stage));
     }
-    const int searched = ChooseModels(scope, options_.tracking, options_.max_instances, &models);
+    int searched = ChooseModels(scope, options_.tracking, options_.max_instances, &models);
+    if (targets) {
+      for (ModelInFrame& model : models) model.search = model.search && model.max_instances > 0;
+      searched =
+          static_cast<int>(std::count_if(models.begin(), models.end(), [](const ModelInFrame& m) { return m.search; }));
+    }
     const bool context = options_.point_pairs.source != HypothesisSource::kPpf;
     if (context && searched > 0) {  // none when all are tracked
       DescribeScene(library_.feature_settings(), options_, &scene, &times);
@@ -187,6 +198,7 @@ class Recognizer::Impl {
     }
     const Clock::time_point stage = Clock::now();
     result.detections = SuppressOverlaps(frame.depth.size(), std::move(candidates));
+    if (targets) AddBestRejected(&models, &result.detections);
     if (scene.verified_log) result.verified = SortedByModel(std::move(scene.verified_log->poses));
     times.Add(Stage::kVerify, MillisecondsSince(stage));
     times.Add(Stage::kTotal, MillisecondsSince(start));
@@ -214,11 +226,38 @@ class Recognizer::Impl {
                                                        : detection.score >= options_.verify.min_score;
   }
 
-  // Accepted, the verdict kept in `model` with keep_judged.
-  bool Judge(const Detection& detection, ModelInFrame* model) const {
-    const bool accepted = Accepted(detection);
-    if (options_.keep_judged) model->judged.push_back({detection, accepted});
+  // Accepted, the verdict kept in `model` with keep_judged; the best rejected pose kept in it.
+  bool Judge(const VerifiedPose& pose, ModelInFrame* model) const {
+    const bool accepted = Accepted(pose.detection);
+    if (options_.keep_judged) model->judged.push_back({pose.detection, accepted});
+    if (!accepted && (!model->best_rejected || pose.detection.score > model->best_rejected->detection.score)) {
+      model->best_rejected = pose;
+    }
     return accepted;
+  }
+
+  // The instances a target model is looked for: its count, none for a model not among the targets.
+  static int TargetCount(const std::map<std::string, int>& targets, const std::string& model) {
+    const auto target = targets.find(model);
+    return target == targets.end() ? 0 : target->second;
+  }
+
+  // Per model that found fewer instances than it was looked for, its best rejected pose (accepted false), appended
+  // to `detections` after them in score order.
+  static void AddBestRejected(std::vector<ModelInFrame>* models, std::vector<Detection>* detections) {
+    std::vector<Detection> rejected;
+    for (ModelInFrame& model : *models) {
+      if (!model.best_rejected) continue;
+      const std::string& name = model.best_rejected->detection.model;
+      const auto found = std::count_if(detections->begin(), detections->end(),
+                                       [&](const Detection& detection) { return detection.model == name; });
+      if (found >= model.max_instances) continue;
+      rejected.push_back(std::move(model.best_rejected->detection));
+      rejected.back().accepted = false;
+    }
+    std::stable_sort(rejected.begin(), rejected.end(),
+                     [](const Detection& a, const Detection& b) { return a.score > b.score; });
+    detections->insert(detections->end(), rejected.begin(), rejected.end());
   }
 
   ModelSearch Search(size_t model, const Scene& scene, int ransac_threads) {
@@ -236,7 +275,7 @@ class Recognizer::Impl {
       std::vector<Followed> followed;
       for (const Detection* prior : model.priors) {
         VerifiedPose tracked = Track(m, *prior, scene);
-        if (Judge(tracked.detection, &model)) {
+        if (Judge(tracked, &model)) {
           followed.push_back({std::move(tracked), !prior->tracked});
         } else {
           model.lost = true;
@@ -273,7 +312,7 @@ class Recognizer::Impl {
     // A view's other descriptors are matched when it is tried: views after a good enough one are not.
     std::vector<ViewCandidate> ranked = search.RankViews();
     result.times.Add(Stage::kRank, MillisecondsSince(ranking));
-    while (static_cast<int>(model->instances.size()) < options_.max_instances) {
+    while (static_cast<int>(model->instances.size()) < model->max_instances) {
       // Once an instance is found the model is known to be in the frame: more of its views are worth trying.
       const bool first = model->instances.empty();
       const int views =
@@ -281,7 +320,7 @@ class Recognizer::Impl {
       std::optional<VerifiedPose> best =
           search.BestPose(views, first ? options_.give_up_after_views : 0, model->covered, &ranked, &result.times);
       if (best && options_.twins.enabled) best = BestTwin(m, scene, std::move(*best), &result.times);
-      if (!best || !Judge(best->detection, model)) break;
+      if (!best || !Judge(*best, model)) break;
       AddInstance(std::move(*best), options_.dense_stride_px, scene.frame->depth.size(), model);
     }
     result.views_tried = static_cast<int>(
@@ -416,7 +455,7 @@ class Recognizer::Impl {
     ParallelFor(wanted.size(), options_.threads, [&](size_t i) {
       std::optional<VerifiedPose> best = BestPointPairPose(wanted[i], scene, open, explained, &model_times[i]);
       if (best && options_.twins.enabled) best = BestTwin(wanted[i], scene, std::move(*best), &model_times[i]);
-      if (best && Judge(best->detection, &(*models)[wanted[i]])) {
+      if (best && Judge(*best, &(*models)[wanted[i]])) {
         AddInstance(std::move(*best), options_.dense_stride_px, scene.frame->depth.size(), &(*models)[wanted[i]]);
       }
     });
@@ -601,6 +640,13 @@ RecognitionResult Recognizer::Recognize(const RgbdFrame& frame) {
 RecognitionResult Recognizer::Recognize(const RgbdFrame& frame, const std::vector<Detection>& priors,
                                         SearchScope scope) {
   return impl_->Recognize(frame, priors, scope);
+}
+
+RecognitionResult Recognizer::RecognizeTargets(const RgbdFrame& frame, const std::map<std::string, int>& targets) {
+  for (const auto& [model, count] : targets) {
+    if (count < 1) ThrowInputError("targets", model, "at least 1 instance", std::to_string(count));
+  }
+  return impl_->Recognize(frame, {}, SearchScope::kAllModels, &targets);
 }
 
 std::map<std::string, std::vector<RankedView>> Recognizer::RankViews(const RgbdFrame& frame) {

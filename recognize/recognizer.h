@@ -34,6 +34,13 @@ class Recognizer {
   RecognitionResult Recognize(const RgbdFrame& frame, const std::vector<Detection>& priors,
                               SearchScope scope = SearchScope::kAllModels);
 
+  /// BOP's localisation task (beyond the paper): only the models of `targets` (name -> instances in the frame, at
+  /// least 1) are looked for, each for up to its count of instances whatever RecognizerOptions::max_instances says;
+  /// a model that found fewer also reports the best pose its acceptance rejected (Detection::accepted false, after
+  /// the accepted ones), so that every target gets an estimate when any pose was verified. Names not in the library
+  /// are ignored.
+  RecognitionResult RecognizeTargets(const RgbdFrame& frame, const std::map<std::string, int>& targets);
+
   /// View ranking alone, for studying it: every model's views as Recognize ranks them in `frame`, best first
   /// (RANSAC tries the first views_per_model of them).
   std::map<std::string, std::vector<RankedView>> RankViews(const RgbdFrame& frame);

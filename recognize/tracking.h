@@ -4,6 +4,7 @@
 // searched, and how a confirming search's instances and the tracks it set aside are merged. No rendering: the
 // recognizer verifies, these functions decide.
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,7 +26,9 @@ struct ModelInFrame {
   bool search = false;
   /// Tracked instances due for confirmation, set aside while their model is searched as if it had no priors.
   std::vector<VerifiedPose> to_confirm;
-  std::vector<JudgedPose> judged;  ///< with RecognizerOptions::keep_judged: the poses its acceptance judged
+  std::vector<JudgedPose> judged;             ///< with RecognizerOptions::keep_judged: the poses its acceptance judged
+  int max_instances = 1;                      ///< instances looked for in this frame (a search stops at as many)
+  std::optional<VerifiedPose> best_rejected;  ///< the best-scoring pose its acceptance turned down
 };
 
 /// Adds `verified` to `model`'s instances and its surface (sampled every `stride` pixels) to the covered pixels.
