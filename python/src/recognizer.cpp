@@ -43,6 +43,14 @@ class StreamRecognizer {
     return result;
   }
 
+  // BOP's localisation task on one frame (Recognizer::RecognizeTargets); the stream's tracks are left as they are.
+  RecognitionResult RecognizeTargets(const RgbdFrame& frame, const std::map<std::string, int>& targets) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    RecognitionResult result = recognizer_.RecognizeTargets(frame, targets);
+    last_timings_ms_ = result.timings_ms;
+    return result;
+  }
+
   void Reset() {
     const std::lock_guard<std::mutex> lock(mutex_);
     stream_.Reset();
@@ -231,6 +239,8 @@ void BindDetection(py::module_& m) {
       .def_readonly("acceptance", &Detection::acceptance,
                     "the learned acceptance's probability that it is right (-1: not used)")
       .def_readonly("tracked", &Detection::tracked)
+      .def_readonly("accepted", &Detection::accepted,
+                    "False for a target's best pose that the acceptance rejected (recognize_targets)")
       .def_readonly("frames_followed", &Detection::frames_followed)
       .def_readonly("confirmed", &Detection::confirmed)
       .def_property_readonly("hypothesis", [](const Detection& d) { return HypothesisSourceName(d.hypothesis_source); })
@@ -305,6 +315,20 @@ void BindRecognizer(py::module_& m) {
             return DetectionList(result);
           },
           py::arg("frame"), "recognize() on a Frame from load_frame.")
+      .def(
+          "recognize_targets",
+          [](StreamRecognizer& recognizer, const LoadedFrame& frame, const std::map<std::string, int>& targets) {
+            RecognitionResult result;
+            {
+              py::gil_scoped_release release;
+              result = recognizer.RecognizeTargets(frame.rgbd, targets);
+            }
+            return DetectionList(result);
+          },
+          py::arg("frame"), py::arg("targets"),
+          "BOP's localisation task on a Frame from load_frame: only the models of `targets` ({name: instances}) are "
+          "looked for, each reporting up to that many poses, the best by score, without a threshold (a pose the "
+          "acceptance rejected has accepted False).")
       .def(
           "draw",
           [](StreamRecognizer& recognizer, const py::array& color, const py::array& depth, const py::object& k,

@@ -143,6 +143,42 @@ TEST_F(RecognizeEndToEnd, FindsTheObjectsOfTheDemoFrameWithinTenthOfTheirDiamete
   EXPECT_NE(eval.output.find("| 003_cracker_box | yes |"), std::string::npos) << eval.output;
 }
 
+// BOP's localisation task: only the targets are looked for, and a target whose pose the acceptance turns down still
+// reports it (not accepted). With a bar no pose reaches, Recognize finds nothing while RecognizeTargets gives each
+// target its best pose, which in the demo frame is the right one.
+TEST_F(RecognizeEndToEnd, RecognizeTargetsGivesEachTargetItsBestPoseEvenWhenNoneIsAccepted) {
+  const ModelLibrary library = Library();
+  const std::vector<EvalModel> models = EvalModels(library);
+  const LoadedFrame frame = LoadYcbvFrame(Frame());
+  RecognizerOptions options;
+  options.verify.min_score = 0.999;
+  Recognizer strict(library, options);
+  EXPECT_TRUE(strict.Recognize(frame.rgbd).detections.empty());
+  const std::vector<Detection> targets =
+      strict.RecognizeTargets(frame.rgbd, {{"003_cracker_box", 1}, {"004_sugar_box", 2}}).detections;
+  ASSERT_EQ(targets.size(), 2U) << "one pose per model: a search stops at its first rejected pose";
+  for (const Detection& detection : targets) {
+    EXPECT_FALSE(detection.accepted);
+    EXPECT_THAT(detection.model, testing::AnyOf("003_cracker_box", "004_sugar_box"));
+  }
+  EXPECT_NE(targets[0].model, targets[1].model);
+  EXPECT_GE(targets[0].score, targets[1].score);
+  const FrameEvaluation evaluation = EvaluateFrame("0001/000001", targets, frame.ground_truth, models);
+  EXPECT_EQ(evaluation.false_positives, 0);
+  for (const ObjectEvaluation& object : evaluation.objects) {
+    if (object.model != "006_mustard_bottle") {
+      EXPECT_TRUE(object.correct) << object.model;
+    }
+  }
+
+  Recognizer usual(library, RecognizerOptions());
+  const std::vector<Detection> mustard = usual.RecognizeTargets(frame.rgbd, {{"006_mustard_bottle", 1}}).detections;
+  ASSERT_EQ(mustard.size(), 1U);
+  EXPECT_TRUE(mustard[0].accepted);
+  EXPECT_EQ(EvaluateFrame("0001/000001", mustard, frame.ground_truth, models).false_positives, 0);
+  EXPECT_THROW(usual.RecognizeTargets(frame.rgbd, {{"006_mustard_bottle", 0}}), InputError);
+}
+
 // The learned acceptance (`--acceptance learned`) decides by its probability, which the detections carry: the demo
 // frame's three objects are found at their true poses by it too, nothing else; the hand-set rule computes none.
 TEST_F(RecognizeEndToEnd, TheLearnedAcceptanceFindsTheDemoFramesObjects) {
