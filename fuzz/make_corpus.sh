@@ -13,7 +13,7 @@ seeds() { ASAN_OPTIONS=detect_leaks=0 "$build/fuzz/ecv_fuzz_seeds" "$@"; }
 separator=$'\n--ecvfuzz-part--\n'  # fuzz_util.h's kPartSeparator
 rm -rf "$work"
 mkdir -p "$work"
-for target in png_frame frame_json ycbv_meta bop_scene pcd pose_json mesh_blob mesh serve_request oni; do
+for target in png_frame frame_json ycbv_meta bop_scene bop_task pcd pose_json mesh_blob mesh serve_request oni; do
   mkdir -p "$corpus/fuzz_$target"
 done
 
@@ -101,6 +101,17 @@ entry() { printf '{\n%s\n}\n' "$(grep -m1 '^  "3":' "$1" | sed 's/,$//')"; }
   entry "$bop/scene_gt_info.json"
 } >"$corpus/fuzz_bop_scene/seed-lmo"
 entry "$bop/scene_camera.json" >"$corpus/fuzz_bop_scene/seed-lmo-camera-only"
+
+# BOP task files: targets of the LM-O image (one per object of its ground truth; first byte 0) and a results CSV of two
+# estimates (first byte 1).
+{
+  printf '\0['
+  grep -m1 '^  "3":' "$bop/scene_gt.json" | grep -o '"obj_id": [0-9]*' | sed 's/"obj_id": \([0-9]*\)/{"im_id": 3, "inst_count": 1, "obj_id": \1, "scene_id": 2}/' |
+    paste -sd, -
+  printf ']\n'
+} >"$corpus/fuzz_bop_task/seed-targets"
+printf '\1scene_id,im_id,obj_id,score,R,t,time\n2,3,1,0.5,1 0 0 0 1 0 0 0 1,10 -20 800,0.4\n2,3,5,0.25,0 -1 0 1 0 0 0 0 1,1.5 2 950.25,0.4\n' \
+  >"$corpus/fuzz_bop_task/seed-results"
 
 # PCD: a crop of PCL's organized table scene, and the first points of the cut-out milk carton (xyz, and xyz rgba).
 for cloud in milk_cartoon_all_small_clorox milk_color milk; do
