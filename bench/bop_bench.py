@@ -97,7 +97,23 @@ def bop_run(args, dataset, library, targets, hypotheses, seed, work):
     with open(targets, encoding="utf-8") as file:
         images = {(t["scene_id"], t["im_id"]) for t in json.load(file)}
     seconds = statistics.mean(times.values()) if times else float("nan")
-    return ar_all, ar_modelled, instances, seconds, len(images) - len(times)
+    return ar_all, ar_modelled, instances, seconds, len(images) - len(times), models
+
+
+def object_table(name, columns):
+    """Markdown rows of AR per object (mean over seeds) of one dataset, one column per library and hypotheses."""
+    objects = sorted({o for per_seed in columns.values() for seed in per_seed.values() for o in seed},
+                     key=lambda o: o.replace(" (no model)", ""))
+    lines = ["", f"{name}: AR per object over all its scenes, mean over seeds.", "",
+             "| object | instances | " + " | ".join(columns) + " |", "|---|---:|" + "---:|" * len(columns)]
+    for obj in objects:
+        cells, instances = [], 0
+        for per_seed in columns.values():
+            ars = [seed[obj][0] / seed[obj][1] for seed in per_seed.values() if obj in seed and seed[obj][1]]
+            cells.append(f"{statistics.mean(ars):.3f}" if ars else "")
+            instances = max([instances] + [seed[obj][1] for seed in per_seed.values() if obj in seed])
+        lines.append(f"| {obj} | {instances} | " + " | ".join(cells) + " |")
+    return lines
 
 
 def main():
@@ -115,17 +131,27 @@ def main():
                  "s/image: BOP's time column (reading the image to the estimates), mean over images and seeds.", "",
                  "| dataset | models | hypotheses | scene | instances | AR | AR (modelled) | s/image |",
                  "|---|---:|---|---:|---:|---:|---:|---:|"]
+        per_object = {}  # dataset -> {"N models, hypotheses": {seed: {object: [AR x instances, instances]}}}
         for name, dataset, library, count in libraries(args, work):
             for hypotheses in ("context", "both"):
-                totals = {seed: [0.0, 0.0, 0, 0] for seed in args.seeds}  # AR x inst, modelled x inst, inst, n
+                totals = {seed: [0.0, 0.0, 0, 0] for seed in args.seeds}  # AR x inst, modelled AR x modelled inst, inst, modelled inst
+                objects = {seed: {} for seed in args.seeds}
+                per_object.setdefault(name, {})[f"{count} models, {hypotheses}"] = objects
                 for scene, targets in scene_targets(dataset, work).items():
                     runs = [bop_run(args, dataset, library, targets, hypotheses, seed, work) for seed in args.seeds]
                     ars = [r[0] for r in runs]
                     for seed, r in zip(args.seeds, runs):
                         modelled = r[1] if r[1] == r[1] else 0.0  # nan: no modelled instance
+                        modelled_instances = sum(m["instances"] for o, m in r[5].items()
+                                                 if not o.endswith("(no model)"))
                         totals[seed][0] += r[0] * r[2]
-                        totals[seed][1] += modelled * r[2]
+                        totals[seed][1] += modelled * modelled_instances
                         totals[seed][2] += r[2]
+                        totals[seed][3] += modelled_instances
+                        for obj, m in r[5].items():
+                            sums = objects[seed].setdefault(obj, [0.0, 0])
+                            sums[0] += m["ar"] * m["instances"]
+                            sums[1] += m["instances"]
                     failed = sum(r[4] for r in runs)
                     lines.append(f"| {name} | {count} | {hypotheses} | {scene} | {runs[0][2]} | "
                                  f"{statistics.mean(ars):.3f} ({min(ars):.3f}-{max(ars):.3f}) | "
@@ -134,8 +160,12 @@ def main():
                                  + (f" ({failed} images failed)" if failed else "") + " |")
                     print(lines[-1], file=sys.stderr)
                 overall = [t[0] / t[2] for t in totals.values()]
+                modelled = [t[1] / t[3] if t[3] else float("nan") for t in totals.values()]
                 lines.append(f"| {name} | {count} | {hypotheses} | **all** | {next(iter(totals.values()))[2]} | "
-                             f"**{statistics.mean(overall):.3f}** ({min(overall):.3f}-{max(overall):.3f}) | | |")
+                             f"**{statistics.mean(overall):.3f}** ({min(overall):.3f}-{max(overall):.3f}) | "
+                             f"{statistics.mean(modelled):.3f} | |")
+        for name, columns in per_object.items():
+            lines += object_table(name, columns)
         lines += ["", f"Published for comparison: Vidal et al. 2018 (point pair features), AR {VIDAL_LMO_AR} on LM-O over "
                   "its 200 test images; ours on LM-O is one image (8 instances), so its figure is a spot check, not "
                   "a leaderboard entry. YCB-V here is 30 training-video frames of 3 videos, not BOP's YCB-V test set; "

@@ -27,7 +27,7 @@ import tempfile
 OWN_FLAGS = {
     "recognize": {"--help", "--db", "--models", "--sequence", "--follow", "--latest", "--idle-timeout", "--out-json",
                   "--out-bop", "--scene-id", "--image-id", "--overlay", "--color", "--depth", "--depth-scale",
-                  "--camera"},
+                  "--camera", "--targets"},
     "serve": {"--help", "--db", "--models", "--socket", "--max-clients", "--idle-timeout", "--root", "--socket-mode",
               "--max-request-bytes"},
     "recognize_bench": {"--help", "--db", "--lmo-db", "--peers", "--peers-only", "--object-pixels", "--bytes",
