@@ -3,7 +3,7 @@
 default, and no recognizer setting the table lacks (issue 56).
 
 The table is what `ecvpose recognize --settings-json` prints (recognize/recognizer_settings.cpp). Checked against it:
-- the flags of `ecvpose recognize --help` and `ecvpose serve --help`;
+- the flags of `ecvpose recognize --help`, `ecvpose serve --help` and `ecvpose bop --help`;
 - the flags of `recognize_bench --help` and `generalisation_bench --help` (--bench; skipped, saying so, without);
 - the Python Recognizer (--python-dir; skipped, saying so, without): a recognizer made with every keyword set to a
   value other than its default shows those values in `settings`, one made without keywords the defaults, and
@@ -28,6 +28,8 @@ OWN_FLAGS = {
     "recognize": {"--help", "--db", "--models", "--sequence", "--follow", "--latest", "--idle-timeout", "--out-json",
                   "--out-bop", "--scene-id", "--image-id", "--overlay", "--color", "--depth", "--depth-scale",
                   "--camera", "--targets"},
+    "bop": {"--help", "--db", "--models", "--dataset", "--split", "--targets", "--out", "--models-info", "--restart",
+            "--out-md", "--out-json"},
     "serve": {"--help", "--db", "--models", "--socket", "--max-clients", "--idle-timeout", "--root", "--socket-mode",
               "--max-request-bytes"},
     "recognize_bench": {"--help", "--db", "--lmo-db", "--peers", "--peers-only", "--object-pixels", "--bytes",
@@ -42,8 +44,8 @@ OWN_FLAGS = {
 NOT_TAKEN = {"recognize_bench": {"--search-beside"}, "generalisation_bench": {"--search-beside"}}
 CORES = min(256, os.cpu_count() or 1)
 # Defaults a front end sets apart from the table's: the worker threads.
-OWN_DEFAULTS = {"recognize": {"threads": CORES}, "serve": {"threads": CORES}, "generalisation_bench": {"threads": 2},
-                "python": {"threads": 2}}
+OWN_DEFAULTS = {"recognize": {"threads": CORES}, "serve": {"threads": CORES}, "bop": {"threads": CORES},
+                "generalisation_bench": {"threads": 2}, "python": {"threads": 2}}
 
 
 def run(command, **kwargs):
@@ -220,7 +222,7 @@ def main():
     table = json.loads(run([args.ecvpose, "recognize", "--settings-json"]))
     failures = []
     check_table(table, failures)
-    for command in ("recognize", "serve"):
+    for command in ("recognize", "serve", "bop"):
         check_help(command, run([args.ecvpose, command, "--help"]), table, failures)
     notes = [f"{len(table)} settings"]
     for bench in ("recognize_bench", "generalisation_bench"):
