@@ -2,6 +2,7 @@
 // and migrate it. Compiled only into the ecvpose executable; reads flags into options and calls ecv_modeldb.
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <map>
@@ -240,6 +241,7 @@ nlohmann::ordered_json SummaryJson(const ModelSummary& m, int bop_object_id) {
           {"descriptor_sha256", m.descriptor_sha256},
           {"color_matrix", m.has_color_matrix},
           {"stored_mesh_bytes", m.mesh_blob_bytes},
+          {"stored_bytes", StoredBytes(m)},
           {"point_pairs", PointPairsJson(m)},
           {"build_options", nlohmann::json::parse(m.build_options_json, nullptr, false)},
           {"created", m.created}};
@@ -257,14 +259,21 @@ int RunList(const ModeldbArgs& args) {
   }
   std::printf("%s: %zu models (schema version %d)\n", args.db.c_str(), models.size(), kModelDbSchemaVersion);
   if (models.empty()) return kExitOk;
-  std::printf("%-28s %6s %6s %11s %12s %12s %9s %7s %8s %10s  %s\n", "name", "obj_id", "views", "primitives",
-              "descriptors", "diameter_mm", "symmetric", "colour", "mesh_MB", "ppf_points", "created");
+  std::printf("%-28s %6s %6s %11s %12s %12s %9s %7s %8s %10s %9s  %s\n", "name", "obj_id", "views", "primitives",
+              "descriptors", "diameter_mm", "symmetric", "colour", "mesh_MB", "ppf_points", "stored_MB", "created");
+  long long stored = 0;
   for (const ModelSummary& m : models) {
     const std::string mesh = m.mesh_blob_bytes > 0 ? Fixed(m.mesh_blob_bytes / 1e6, 1) : "file";  // not stored
-    std::printf("%-28s %6d %6d %11d %12d %12.1f %9s %7s %8s %10s  %s\n", m.name.c_str(), object_ids.at(m.name),
+    std::printf("%-28s %6d %6d %11d %12d %12.1f %9s %7s %8s %10s %9.1f  %s\n", m.name.c_str(), object_ids.at(m.name),
                 m.num_views, m.num_primitives, m.num_descriptors, 1000.0 * m.diameter_m, m.symmetric ? "yes" : "no",
-                m.has_color_matrix ? "yes" : "no", mesh.c_str(), PointPairsColumn(m).c_str(), m.created.c_str());
+                m.has_color_matrix ? "yes" : "no", mesh.c_str(), PointPairsColumn(m).c_str(), StoredBytes(m) / 1e6,
+                m.created.c_str());
+    stored += StoredBytes(m);
   }
+  std::error_code error;
+  const auto file_bytes = static_cast<long long>(std::filesystem::file_size(args.db, error));
+  std::printf("stored values %.1f MB in a file of %s MB\n", stored / 1e6,
+              error ? "?" : Fixed(static_cast<double>(file_bytes) / 1e6, 1).c_str());
   return kExitOk;
 }
 

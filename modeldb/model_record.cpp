@@ -157,6 +157,14 @@ std::string ModelRecord::DescriptorSha256() const {
   return hash.HexDigest();
 }
 
+long long StoredBytes(const ModelSummary& model) {
+  constexpr long long kDescriptorBytes = kDescriptorSize * sizeof(float);
+  constexpr long long kPrimitiveBytes = 13 * 8;     // position, orientation, colour, image position, magnitude, angle
+  constexpr long long kPointBytes = 6 * sizeof(float);  // position and normal
+  return model.num_descriptors * kDescriptorBytes + model.num_primitives * kPrimitiveBytes + model.mesh_blob_bytes +
+         std::max(0, model.point_pair_points) * kPointBytes;
+}
+
 TriangleMesh ModelMesh(const ModelRecord& record, bool with_textures, std::vector<std::string>* warnings) {
   if (!record.mesh_blob.empty()) {
     return DecodeMeshBlob(record.mesh_blob.data(), record.mesh_blob.size(), "model " + record.name + ": stored mesh",

@@ -131,4 +131,9 @@ struct ModelSummary {
   std::string created;             ///< UTC time of storing, ISO 8601
 };
 
+/// The bytes of a model's stored values: its descriptors (kDescriptorSize float32 each), its primitives' 13 numbers
+/// (8 bytes each), its mesh and its point pair points (6 float32 each). The library file holds these and, about 10 %
+/// more, the rows' keys and SQLite's pages.
+long long StoredBytes(const ModelSummary& model);
+
 }  // namespace ecv

@@ -166,7 +166,22 @@ TEST_F(ModeldbCli, BuildsTwoModelsThatOtherProcessesReadBackBitForBit) {
 TEST_F(ModeldbCli, ListsAndExportsPrimitivesInTheObjectFrame) {
   const test::CommandResult list = test::RunCli("modeldb list --db " + library_);
   ASSERT_EQ(list.exit_code, 0) << list.output;
-  EXPECT_THAT(list.output, AllOf(HasSubstr("2 models"), HasSubstr("003_cracker_box"), HasSubstr("006_mustard_bottle")));
+  EXPECT_THAT(list.output, AllOf(HasSubstr("2 models"), HasSubstr("003_cracker_box"), HasSubstr("006_mustard_bottle"),
+                                 HasSubstr("stored_MB"), HasSubstr("stored values")));
+  // Each model's stored bytes: its descriptors, primitives, mesh and point pair points; together most of the file.
+  const nlohmann::json listed = nlohmann::json::parse(test::RunCli("modeldb list --json --db " + library_).output);
+  long long stored = 0;
+  for (const nlohmann::json& model : listed) {
+    const long long points = model["point_pairs"].is_null() ? 0 : model["point_pairs"]["points"].get<long long>();
+    EXPECT_EQ(model["stored_bytes"].get<long long>(),
+              model["descriptors"].get<long long>() * 384 + model["primitives"].get<long long>() * 104 +
+                  model["stored_mesh_bytes"].get<long long>() + points * 24)
+        << model["name"];
+    stored += model["stored_bytes"].get<long long>();
+  }
+  const auto file_bytes = static_cast<long long>(fs::file_size(library_));
+  EXPECT_LT(stored, file_bytes);
+  EXPECT_GT(stored, file_bytes / 2) << "the values are most of the file";
 
   const std::string ply = scratch_.File("box.ply");
   const test::CommandResult exported =
