@@ -159,7 +159,7 @@ std::string ModelRecord::DescriptorSha256() const {
 
 long long StoredBytes(const ModelSummary& model) {
   constexpr long long kDescriptorBytes = kDescriptorSize * sizeof(float);
-  constexpr long long kPrimitiveBytes = 13 * 8;     // position, orientation, colour, image position, magnitude, angle
+  constexpr long long kPrimitiveBytes = 13 * 8;  // position, orientation, colour, image position, magnitude, angle
   constexpr long long kPointBytes = 6 * sizeof(float);  // position and normal
   return model.num_descriptors * kDescriptorBytes + model.num_primitives * kPrimitiveBytes + model.mesh_blob_bytes +
          std::max(0, model.point_pair_points) * kPointBytes;

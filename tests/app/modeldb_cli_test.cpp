@@ -173,9 +173,9 @@ TEST_F(ModeldbCli, ListsAndExportsPrimitivesInTheObjectFrame) {
   long long stored = 0;
   for (const nlohmann::json& model : listed) {
     const long long points = model["point_pairs"].is_null() ? 0 : model["point_pairs"]["points"].get<long long>();
-    EXPECT_EQ(model["stored_bytes"].get<long long>(),
-              model["descriptors"].get<long long>() * 384 + model["primitives"].get<long long>() * 104 +
-                  model["stored_mesh_bytes"].get<long long>() + points * 24)
+    EXPECT_EQ(model["stored_bytes"].get<long long>(), model["descriptors"].get<long long>() * 384 +
+                                                          model["primitives"].get<long long>() * 104 +
+                                                          model["stored_mesh_bytes"].get<long long>() + points * 24)
         << model["name"];
     stored += model["stored_bytes"].get<long long>();
   }
