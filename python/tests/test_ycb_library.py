@@ -54,6 +54,7 @@ def test_named_objects_are_built_in_the_ycbv_frame_with_ycbv_ids_and_symmetry(tm
     for name, model in models.items():
         assert np.allclose(np.array(model["object_from_mesh"]), frames[name], atol=1e-6), name
         assert model["views"] == 2
+        assert model["mesh_path"] == str((OBJECTS / name / "textured.obj").resolve()), "the mesh file, not a copy"
 
 
 @NO_OBJECTS
@@ -63,3 +64,5 @@ def test_an_unknown_object_is_named_and_nothing_is_built(tmp_path):
     assert refused.returncode == 1
     assert "999_no_such_object" in refused.stderr
     assert not library.exists()
+    bad_flag = run(SCRIPT, library, "--objects", "010_potted_meat_can", "--no-such-flag")
+    assert bad_flag.returncode == 2
