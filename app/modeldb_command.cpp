@@ -264,11 +264,12 @@ int RunList(const ModeldbArgs& args) {
   long long stored = 0;
   for (const ModelSummary& m : models) {
     const std::string mesh = m.mesh_blob_bytes > 0 ? Fixed(m.mesh_blob_bytes / 1e6, 1) : "file";  // not stored
+    const long long bytes = StoredBytes(m);
     std::printf("%-28s %6d %6d %11d %12d %12.1f %9s %7s %8s %10s %9.1f  %s\n", m.name.c_str(), object_ids.at(m.name),
                 m.num_views, m.num_primitives, m.num_descriptors, 1000.0 * m.diameter_m, m.symmetric ? "yes" : "no",
-                m.has_color_matrix ? "yes" : "no", mesh.c_str(), PointPairsColumn(m).c_str(), StoredBytes(m) / 1e6,
+                m.has_color_matrix ? "yes" : "no", mesh.c_str(), PointPairsColumn(m).c_str(), bytes / 1e6,
                 m.created.c_str());
-    stored += StoredBytes(m);
+    stored += bytes;
   }
   std::error_code error;
   const auto file_bytes = static_cast<long long>(std::filesystem::file_size(args.db, error));

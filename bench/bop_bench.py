@@ -100,6 +100,13 @@ def bop_run(args, dataset, library, targets, hypotheses, seed, work):
     return ar_all, ar_modelled, instances, seconds, len(images) - len(times), models
 
 
+def pooled(objects, keep):
+    """Instance-weighted AR over the objects `keep` accepts of {object: [AR x instances, instances]}, and instances."""
+    sums = [v for o, v in objects.items() if keep(o)]
+    instances = sum(v[1] for v in sums)
+    return (sum(v[0] for v in sums) / instances if instances else float("nan")), instances
+
+
 def object_table(name, columns):
     """Markdown rows of AR per object (mean over seeds) of one dataset, one column per library and hypotheses."""
     objects = sorted({o for per_seed in columns.values() for seed in per_seed.values() for o in seed},
@@ -134,20 +141,12 @@ def main():
         per_object = {}  # dataset -> {"N models, hypotheses": {seed: {object: [AR x instances, instances]}}}
         for name, dataset, library, count in libraries(args, work):
             for hypotheses in ("context", "both"):
-                totals = {seed: [0.0, 0.0, 0, 0] for seed in args.seeds}  # AR x inst, modelled AR x modelled inst, inst, modelled inst
                 objects = {seed: {} for seed in args.seeds}
                 per_object.setdefault(name, {})[f"{count} models, {hypotheses}"] = objects
                 for scene, targets in scene_targets(dataset, work).items():
                     runs = [bop_run(args, dataset, library, targets, hypotheses, seed, work) for seed in args.seeds]
                     ars = [r[0] for r in runs]
                     for seed, r in zip(args.seeds, runs):
-                        modelled = r[1] if r[1] == r[1] else 0.0  # nan: no modelled instance
-                        modelled_instances = sum(m["instances"] for o, m in r[5].items()
-                                                 if not o.endswith("(no model)"))
-                        totals[seed][0] += r[0] * r[2]
-                        totals[seed][1] += modelled * modelled_instances
-                        totals[seed][2] += r[2]
-                        totals[seed][3] += modelled_instances
                         for obj, m in r[5].items():
                             sums = objects[seed].setdefault(obj, [0.0, 0])
                             sums[0] += m["ar"] * m["instances"]
@@ -159,9 +158,10 @@ def main():
                                  f"{statistics.mean(r[3] for r in runs):.2f}"
                                  + (f" ({failed} images failed)" if failed else "") + " |")
                     print(lines[-1], file=sys.stderr)
-                overall = [t[0] / t[2] for t in totals.values()]
-                modelled = [t[1] / t[3] if t[3] else float("nan") for t in totals.values()]
-                lines.append(f"| {name} | {count} | {hypotheses} | **all** | {next(iter(totals.values()))[2]} | "
+                overall = [pooled(per_seed, lambda o: True)[0] for per_seed in objects.values()]
+                modelled = [pooled(per_seed, lambda o: not o.endswith("(no model)"))[0] for per_seed in objects.values()]
+                instances = pooled(next(iter(objects.values())), lambda o: True)[1]
+                lines.append(f"| {name} | {count} | {hypotheses} | **all** | {instances} | "
                              f"**{statistics.mean(overall):.3f}** ({min(overall):.3f}-{max(overall):.3f}) | "
                              f"{statistics.mean(modelled):.3f} | |")
         for name, columns in per_object.items():
