@@ -3,7 +3,8 @@
 // of the first with ADD-S below 0.1 x diameter (what ICP and verification can take from there), and the time per
 // model and frame, under the settings given.
 //
-//   ppf_bench [--stride 2] [--step 5] [--coplanar 12] [--scene-normals 30] [--spread-margin 0.5] [--frames 000001]
+//   ppf_bench [--stride 2] [--reference-spacing 0.4] [--coplanar 12] [--scene-normals 30] [--spread-margin 0.5]
+//   [--frames 000001]
 //             [--results F]
 
 #include <CLI/CLI.hpp>
@@ -30,7 +31,8 @@ int Run(int argc, char** argv) {
   int stride = 2;
   std::string frames_filter, results = std::string(ECV_SOURCE_DIR) + "/bench/RESULTS.md";
   app.add_option("--stride", stride, "Scene depth samples every N pixels")->capture_default_str();
-  app.add_option("--step", options.scene_reference_step, "Every N-th sub-sampled scene point is a reference")
+  app.add_option("--reference-spacing", options.reference_spacing,
+                 "Reference points: one per voxel of this share of the diameter and differing normal")
       ->capture_default_str();
   app.add_option("--coplanar", options.coplanar_deg, "Pairs of one plane within this angle are skipped (degrees)")
       ->capture_default_str();

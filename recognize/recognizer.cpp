@@ -478,24 +478,34 @@ class Recognizer::Impl {
   }
 
   // The model's best point pair pose clusters among the scene's oriented `points` (the `explained` ones only paired
-  // with), each verified, refined by ICP and verified again (the better kept); the best of them.
+  // with), each verified; those that scored rival_min_ratio of the best of them refined by ICP and verified again (the
+  // better kept): ICP is the dearest step, and a coarse pose far below the best rarely wins after it. The best of them.
   std::optional<VerifiedPose> BestPointPairPose(size_t model, const Scene& scene,
                                                 const std::vector<OrientedPoint>& points,
                                                 const std::vector<OrientedPoint>& explained, StageTimes* times) {
     Clock::time_point stage = Clock::now();
     const std::vector<PpfPose> poses = FindPpfPoses(*models_[model].point_pairs, points, explained);
     times->Add(Stage::kPointPairs, MillisecondsSince(stage));
+    const size_t count = std::min(poses.size(), static_cast<size_t>(options_.point_pairs.clusters));
+    std::vector<Hypothesis> hypotheses(count);
+    std::vector<VerifiedPose> verified(count);
+    double best_coarse = 0.0;
+    for (size_t c = 0; c < count; ++c) {
+      hypotheses[c].pose = poses[c].camera_from_object;
+      stage = Clock::now();
+      verified[c] = Verify(model, scene, hypotheses[c]);
+      times->Add(Stage::kVerify, MillisecondsSince(stage));
+      best_coarse = std::max(best_coarse, verified[c].search_score);
+    }
     const ModelSearch search = Search(model, scene, 1);
     std::optional<VerifiedPose> best;
-    for (size_t c = 0; c < poses.size() && c < static_cast<size_t>(options_.point_pairs.clusters); ++c) {
-      Hypothesis hypothesis;
-      hypothesis.pose = poses[c].camera_from_object;
-      stage = Clock::now();
-      VerifiedPose verified = Verify(model, scene, hypothesis);
-      times->Add(Stage::kVerify, MillisecondsSince(stage));
-      if (options_.refine) RefineIfBetter(model, scene, search, &hypothesis, &verified, times);
-      verified.detection.hypothesis_source = HypothesisSource::kPpf;
-      if (!best || verified.detection.score > best->detection.score) best = std::move(verified);
+    for (size_t c = 0; c < count; ++c) {
+      if (options_.refine && verified[c].search_score > 0.0 &&
+          verified[c].search_score >= options_.rival_min_ratio * best_coarse) {
+        RefineIfBetter(model, scene, search, &hypotheses[c], &verified[c], times);
+      }
+      verified[c].detection.hypothesis_source = HypothesisSource::kPpf;
+      if (!best || verified[c].detection.score > best->detection.score) best = std::move(verified[c]);
     }
     return best;
   }

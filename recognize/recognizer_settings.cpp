@@ -278,7 +278,8 @@ void AddFurtherSettings(std::vector<Setting>* table) {
   table->push_back(Number(
       "rival-min-ratio", 0, 1,
       "A model's best pose turned more than 90 degrees from its best verified one is refined and verified\n"
-      "too when it scored at least this share of the best (0: never)",
+      "too when it scored at least this share of the best (0: never); a point pair cluster is refined\n"
+      "when it scored this share of the model's best cluster",
       [](auto& s) -> auto& { return s.options.rival_min_ratio; }));
   table->push_back(Flag(
       "twins", true,
@@ -295,8 +296,13 @@ void AddFurtherSettings(std::vector<Setting>* table) {
       [](auto& s) -> auto& { return s.options.icp_max_points; }));
   table->push_back(Count(
       "ppf-clusters", 1, kNoMax,
-      "With --hypotheses ppf or both: the best point pair pose clusters refined and verified per model",
+      "With --hypotheses ppf or both: the point pair pose clusters verified per model, most votes first",
       [](auto& s) -> auto& { return s.options.point_pairs.clusters; }));
+  table->push_back(Number(
+      "ppf-reference-spacing", 0.01, 1,
+      "With --hypotheses ppf or both: point pair reference points, one per voxel of this share of the\n"
+      "model's diameter and differing normal (smaller: more votes, at more time)",
+      [](auto& s) -> auto& { return s.options.point_pairs.ppf.reference_spacing; }));
   table->push_back(FlagOf(
       "ppf-keep-plane", false,
       "With --hypotheses ppf or both: the scene's dominant plane (a table top) votes too (default: left out)",

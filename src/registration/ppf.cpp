@@ -39,8 +39,24 @@ float FastAtan2(float y, float x) {
   return y < 0.0F ? -angle : angle;
 }
 
-float Angle(const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
-  return FastAtan2(a.cross(b).norm(), a.dot(b));
+// acos to within 1e-6 rad over [-1, 1] (Abramowitz and Stegun 4.4.46, its constant term pi / 2 so that a right angle
+// lands exactly on its bin border, as a mesh's box corners do), clamped: one square root and no division.
+float FastAcos(float x) {
+  const float a = std::min(std::abs(x), 1.0F);
+  const float angle =
+      std::sqrt(1.0F - a) *
+      (static_cast<float>(kPi / 2.0) +
+       a * (-0.2145988016F +
+            a * (0.0889789874F +
+                 a * (-0.0501743046F +
+                      a * (0.0308918810F + a * (-0.0170881256F + a * (0.0066700901F + a * -0.0012624911F)))))));
+  return x < 0.0F ? static_cast<float>(kPi) - angle : angle;
+}
+
+// `normal` scaled to unit length (pair features take unit normals), or +z when it has none.
+Eigen::Vector3f UnitOr(const Eigen::Vector3f& normal) {
+  const float length = normal.norm();
+  return length > 0.0F ? Eigen::Vector3f(normal / length) : Eigen::Vector3f::UnitZ();
 }
 
 // The rotation that turns `normal` onto +x (Drost's T_{m->g} without its translation).
@@ -72,14 +88,16 @@ class FeatureBins {
         coplanar_(static_cast<float>(options.coplanar_deg * kPi / 180.0)),
         margin_(static_cast<float>(options.spread_margin)) {}
 
-  // The pair's bin positions (distance, angle(n1, d), angle(n2, d), angle(n1, n2)); false when beyond the diameter
-  // or coplanar (PpfOptions::coplanar_deg).
+  // The pair's bin positions (distance, angle(n1, d), angle(n2, d), angle(n1, n2)) of unit normals; false when beyond
+  // the diameter or coplanar (PpfOptions::coplanar_deg).
   bool Positions(const OrientedPoint& a, const OrientedPoint& b, float positions[4]) const {
     const Eigen::Vector3f d = b.position - a.position;
     const float length = d.norm();
     positions[0] = length * per_distance_;
     if (!(positions[0] < static_cast<float>(distance_bins_)) || length <= 0.0F) return false;
-    const float a1 = Angle(a.normal, d), a2 = Angle(b.normal, d), a3 = Angle(a.normal, b.normal);
+    const Eigen::Vector3f direction = d / length;
+    const float a1 = FastAcos(a.normal.dot(direction)), a2 = FastAcos(b.normal.dot(direction));
+    const float a3 = FastAcos(a.normal.dot(b.normal));
     if (a3 < coplanar_ && std::abs(a1 - kHalfPi) < coplanar_ && std::abs(a2 - kHalfPi) < coplanar_) return false;
     positions[1] = a1 * per_angle_;
     positions[2] = a2 * per_angle_;
@@ -109,16 +127,17 @@ class FeatureBins {
       keys[0] = Key(bins);
       return 1;
     }
-    int count = 0;
-    for (int mask = 0; mask < 16; ++mask) {
-      int chosen[4];
-      bool repeated = false;
-      for (int k = 0; k < 4; ++k) {
-        const bool moved = (mask >> k) & 1;
-        if (moved && other[k] == bins[k]) repeated = true;
-        chosen[k] = moved ? other[k] : bins[k];
+    // Every combination of each value's own bin and, when near a border, its neighbour's: a product over the four.
+    keys[0] = 0;
+    int count = 1;
+    for (int k = 0; k < 4; ++k) {
+      const uint32_t size = k == 0 ? 1U : static_cast<uint32_t>(angle_bins_);
+      const int before = count;
+      for (int c = 0; c < before; ++c) {
+        const uint32_t prefix = keys[c] * size;
+        keys[c] = prefix + static_cast<uint32_t>(bins[k]);
+        if (other[k] != bins[k]) keys[count++] = prefix + static_cast<uint32_t>(other[k]);
       }
-      if (!repeated) keys[count++] = Key(chosen);
     }
     return count;
   }
@@ -207,6 +226,40 @@ std::vector<PpfPose> ClusterPoses(std::vector<Vote> votes, double diameter_m, co
   return clusters;
 }
 
+// One table look-up of a reference point's scene pair: a feature key, the pair's alpha and the pair's 1-based stamp.
+struct Lookup {
+  uint32_t key;
+  uint16_t alpha;
+  uint16_t pair;
+};
+
+// The look-ups' votes into `accumulator` (per model point and rotation bin: the last pair that voted in the high 16
+// bits, the votes in the low 16, so that a pair votes once per cell); returns the table entries voted for. The table
+// is far larger than the cache: each key's offsets and then its entries are fetched a few look-ups ahead.
+size_t CastVotes(const PpfModel& model, const std::vector<Lookup>& lookups, int angle_bins,
+                 std::vector<uint32_t>* accumulator) {
+  constexpr size_t kAhead = 6;  // look-ups between fetching a key's entries and voting with them
+  const size_t count = lookups.size();
+  const auto bins = static_cast<uint32_t>(angle_bins);
+  uint32_t* cells = accumulator->data();
+  size_t entries = 0;
+  for (size_t j = 0; j < count; ++j) {
+    if (j + 2 * kAhead < count) model.PrefetchOffsets(lookups[j + 2 * kAhead].key);
+    if (j + kAhead < count) model.PrefetchEntries(lookups[j + kAhead].key);
+    const Lookup& lookup = lookups[j];
+    const auto [begin, end] = model.Find(lookup.key);
+    entries += static_cast<size_t>(end - begin);
+    const uint32_t stamp = static_cast<uint32_t>(lookup.pair) << 16;
+    for (const PpfModel::Entry* entry = begin; entry != end; ++entry) {
+      // alpha_model - alpha_scene, wrapped to a turn, from -pi: the rotation about x between the two frames.
+      const uint32_t turn = static_cast<uint16_t>(entry->alpha - lookup.alpha + 32768U);
+      uint32_t& cell = cells[entry->reference * bins + ((turn * bins) >> 16)];
+      if ((cell & 0xffff0000U) != stamp) cell = stamp | ((cell & 0xffffU) + 1U);
+    }
+  }
+  return entries;
+}
+
 }  // namespace
 
 void PpfOptions::Check() const {
@@ -218,7 +271,8 @@ void PpfOptions::Check() const {
   require(angle_bins >= 4 && angle_bins <= 180, "angle_bins", "4 to 180");
   require(keep_normal_deg > 0.0 && keep_normal_deg <= 180.0, "keep_normal_deg", "in (0, 180] degrees");
   require(scene_keep_normal_deg > 0.0 && scene_keep_normal_deg <= 180.0, "scene_keep_normal_deg", "in (0, 180]");
-  require(scene_reference_step >= 1, "scene_reference_step", "at least 1");
+  require(reference_spacing > 0.0 && reference_spacing <= 1.0, "reference_spacing",
+          "a share of the diameter in (0, 1]");
   require(poses_per_reference >= 1, "poses_per_reference", "at least 1");
   require(cluster_distance > 0.0, "cluster_distance", "> 0");
   require(spread_margin >= 0.0 && spread_margin <= 0.5, "spread_margin", "a share of a bin in [0, 0.5]");
@@ -417,8 +471,9 @@ PpfModel::PpfModel(std::vector<OrientedPoint> points, double diameter_m, const P
   if (!(diameter_m > 0.0)) ThrowInputError("point pair model", "diameter_m", "> 0 m", std::to_string(diameter_m));
   points_ =
       sampled ? std::move(points) : SubsampleByNormals(points, options.sampling * diameter_m, options.keep_normal_deg);
-  if (points_.size() < 10) {
-    ThrowInputError("point pair model", "surface", "at least 10 points after sub-sampling",
+  for (OrientedPoint& point : points_) point.normal = UnitOr(point.normal);
+  if (points_.size() < 10 || points_.size() > 65536) {
+    ThrowInputError("point pair model", "surface", "10 to 65536 points after sub-sampling (sampling)",
                     std::to_string(points_.size()));
   }
   const FeatureBins bins(diameter_m, options);
@@ -432,7 +487,7 @@ PpfModel::PpfModel(std::vector<OrientedPoint> points, double diameter_m, const P
       uint32_t key[16];
       bins.Keys(positions, false, key);
       keyed.push_back(
-          {key[0], {static_cast<uint32_t>(r), AlphaOf(to_x * (points_[i].position - points_[r].position))}});
+          {key[0], {static_cast<uint16_t>(r), AlphaOf(to_x * (points_[i].position - points_[r].position))}});
     }
   }
   pairs_ = keyed.size();
@@ -461,12 +516,12 @@ std::vector<PpfPose> FindPpfPoses(const PpfModel& model, const std::vector<Orien
         SubsampleByNormals(explained, options.sampling * diameter, options.scene_keep_normal_deg);
     scene.insert(scene.end(), others.begin(), others.end());
   }
+  for (OrientedPoint& point : scene) point.normal = UnitOr(point.normal);
   const FeatureBins bins(diameter, options);
   const CellGrid grid(scene, diameter);
   const size_t model_points = model.points().size();
   const int angle_bins = options.angle_bins;
-  // Per model point and rotation bin: the votes (low 16 bits) and the last scene pair of the reference point that
-  // voted (high 16 bits), so that a pair votes once per cell; one 32-bit word, for one memory access per vote.
+  // Per model point and rotation bin: votes and stamp in one word (CastVotes).
   std::vector<uint32_t> accumulator(model_points * static_cast<size_t>(angle_bins));
   std::vector<Eigen::Matrix3f> model_to_x(model_points);
   for (size_t m = 0; m < model_points; ++m) model_to_x[m] = ToXAxis(model.points()[m].normal);
@@ -476,17 +531,22 @@ std::vector<PpfPose> FindPpfPoses(const PpfModel& model, const std::vector<Orien
   constexpr uint32_t kCount = 0xffffU;
   PpfSearchStats done;
   done.scene_points = scene.size();
-  const auto step = static_cast<size_t>(options.scene_reference_step);
-  done.references = (references + step - 1) / step;
-  for (size_t r = 0; r < references; r += step) {
-    const OrientedPoint& reference = scene[r];
+  // The reference points: the open ones thinned to one per coarse voxel and differing normal, so that every surface
+  // leads votes however few points it has.
+  const std::vector<OrientedPoint> leaders(SubsampleByNormals(
+      std::vector<OrientedPoint>(scene.begin(), scene.begin() + static_cast<std::ptrdiff_t>(references)),
+      options.reference_spacing * diameter, options.scene_keep_normal_deg));
+  done.references = leaders.size();
+  std::vector<Lookup> lookups;  // the reference point's table look-ups, reused
+  for (const OrientedPoint& reference : leaders) {
     const Eigen::Matrix3f to_x = ToXAxis(reference.normal);
     std::fill(accumulator.begin(), accumulator.end(), 0U);
+    lookups.clear();
     uint32_t pair = 0;
     grid.ForNear(reference.position, [&](int i) {
       // A reference point has a few thousand pairs at most (its sub-sampled neighbours within one diameter); any
       // beyond the 16-bit stamps do not vote.
-      if (static_cast<size_t>(i) == r || pair == kCount) return;
+      if (pair == kCount) return;
       const OrientedPoint& other = scene[static_cast<size_t>(i)];
       if ((other.position - reference.position).squaredNorm() > squared_diameter) return;
       float positions[4];
@@ -495,18 +555,9 @@ std::vector<PpfPose> FindPpfPoses(const PpfModel& model, const std::vector<Orien
       const int count = bins.Keys(positions, options.spread_votes, keys);
       const uint16_t alpha_scene = AlphaOf(to_x * (other.position - reference.position));
       ++pair;
-      for (int k = 0; k < count; ++k) {
-        const auto [begin, end] = model.Find(keys[k]);
-        done.entries += static_cast<size_t>(end - begin);
-        for (const PpfModel::Entry* entry = begin; entry != end; ++entry) {
-          // alpha_model - alpha_scene, wrapped to a turn, from -pi: the rotation about x between the two frames.
-          const uint32_t turn = static_cast<uint16_t>(entry->alpha - alpha_scene + 32768U);
-          uint32_t& cell =
-              accumulator[entry->reference * static_cast<size_t>(angle_bins) + ((turn * angle_bins) >> 16)];
-          if ((cell >> 16) != pair) cell = (pair << 16) | ((cell & kCount) + 1U);
-        }
-      }
+      for (int k = 0; k < count; ++k) lookups.push_back({keys[k], alpha_scene, static_cast<uint16_t>(pair)});
     });
+    done.entries += CastVotes(model, lookups, angle_bins, &accumulator);
     done.pairs += pair;
     // The reference point's best cells as poses: camera_from_object = T_s^-1 R_x(alpha) T_m.
     BestCells(accumulator, kCount, static_cast<size_t>(options.poses_per_reference), &peaks);

@@ -28,7 +28,9 @@ struct PpfOptions {
   double keep_normal_deg = 30.0;  ///< a voxel keeps a second point whose normal differs by more than this
   /// The same for the scene's voxels (180: one point per voxel; a depth image's normals are noisy).
   double scene_keep_normal_deg = 30.0;
-  int scene_reference_step = 5;     ///< every n-th sub-sampled scene point is a reference point
+  /// Reference points: the sub-sampled scene thinned again to one point per voxel of this (share of the diameter)
+  /// and differing normal (scene_keep_normal_deg), an even cover of every surface.
+  double reference_spacing = 0.4;
   bool spread_votes = true;         ///< also look up the neighbouring bin of each feature value near a bin border
   double spread_margin = 0.15;      ///< ... "near": within this share of a bin from the border (0.5: always)
   int poses_per_reference = 3;      ///< the best poses of each reference point kept for clustering
@@ -96,8 +98,8 @@ std::vector<OrientedPoint> WithoutDominantPlane(const std::vector<OrientedPoint>
 class PpfModel {
  public:
   /// From the model's surface points (object frame) and its diameter (metres), sub-sampled as `options` say; throws
-  /// InputError when fewer than 10 points remain or fewer than 100 pairs go into the table (a mesh too small, flat
-  /// or coarse for point pairs).
+  /// InputError when fewer than 10 points remain, more than 65536 (a sampling too fine), or fewer than 100 pairs go
+  /// into the table (a mesh too small, flat or coarse for point pairs).
   PpfModel(const std::vector<OrientedPoint>& surface, double diameter_m, const PpfOptions& options = {});
 
   /// From points sub-sampled already (SampleModelPoints, or a library's stored ones); the same refusals.
@@ -113,7 +115,7 @@ class PpfModel {
   /// point into the half-plane y >= 0, z = 0 of the reference's frame, as a turn share in 1/65536 (0: -pi): votes
   /// subtract such angles with wrap-around, in integers.
   struct Entry {
-    uint32_t reference;
+    uint16_t reference;  ///< at most 65536 points per model (PpfModel refuses more)
     uint16_t alpha;
   };
   /// The pairs with feature key `key`, as [begin, end).
@@ -121,6 +123,10 @@ class PpfModel {
     if (key + 1 >= offsets_.size()) return {nullptr, nullptr};
     return {entries_.data() + offsets_[key], entries_.data() + offsets_[key + 1]};
   }
+  /// Hints for a vote loop that looks keys up a few steps ahead: the key's offsets, then (once those are cached) its
+  /// first entries, into the cache.
+  void PrefetchOffsets(uint32_t key) const { __builtin_prefetch(offsets_.data() + key); }
+  void PrefetchEntries(uint32_t key) const { __builtin_prefetch(entries_.data() + offsets_[key]); }
 
  private:
   PpfModel(std::vector<OrientedPoint> points, double diameter_m, const PpfOptions& options, bool sampled);

@@ -95,15 +95,17 @@ TEST(Ppf, ExplainedPointsLeadNoVote) {
   const BoxOnTable scene = MakeBoxOnTable(box, kBoxPose);
   PpfSearchStats stats;
   const std::vector<PpfPose> box_explained = FindPpfPoses(model, scene.table, scene.box, &stats);
-  // Only the table's sub-sampled points lead, every scene_reference_step-th of them; the box's are paired with.
+  // Only the table's sub-sampled points lead, thinned to the reference spacing; the box's are paired with.
   const PpfOptions& options = model.options();
-  const size_t table =
-      SubsampleByNormals(scene.table, options.sampling * box.Diameter(), options.scene_keep_normal_deg).size();
+  const std::vector<OrientedPoint> table =
+      SubsampleByNormals(scene.table, options.sampling * box.Diameter(), options.scene_keep_normal_deg);
   const size_t box_points =
       SubsampleByNormals(scene.box, options.sampling * box.Diameter(), options.scene_keep_normal_deg).size();
-  const auto step = static_cast<size_t>(options.scene_reference_step);
-  EXPECT_EQ(stats.scene_points, table + box_points);
-  EXPECT_EQ(stats.references, (table + step - 1) / step);
+  EXPECT_EQ(stats.scene_points, table.size() + box_points);
+  EXPECT_EQ(
+      stats.references,
+      SubsampleByNormals(table, options.reference_spacing * box.Diameter(), options.scene_keep_normal_deg).size());
+  EXPECT_LT(stats.references * 20, table.size());  // a flat table: about one in (0.4 / 0.05)^2
   EXPECT_GT(stats.pairs, stats.references);
   EXPECT_GT(stats.entries, 0U);
   for (const PpfPose& pose : box_explained) {
