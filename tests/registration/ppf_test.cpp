@@ -187,6 +187,18 @@ TEST(Ppf, RefusesAFlatModelAndBadOptions) {
   PpfOptions options;
   options.angle_bins = 2;
   EXPECT_THROW(options.Check(), InputError);
+  options = PpfOptions();
+  options.reference_spacing = 0.0;
+  EXPECT_THROW(options.Check(), InputError);
+  // A table entry holds its model point in 16 bits: more than 65536 points (a sampling far too fine) are refused.
+  std::vector<OrientedPoint> many(65537);
+  for (size_t i = 0; i < many.size(); ++i) many[i].position = Eigen::Vector3f(0.001F * static_cast<float>(i), 0, 0);
+  try {
+    PpfModel::FromSampledPoints(many, 0.1);
+    ADD_FAILURE() << "65537 points were taken";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("65537"), std::string::npos) << error.what();
+  }
 }
 
 }  // namespace
