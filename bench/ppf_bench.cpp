@@ -3,9 +3,8 @@
 // of the first with ADD-S below 0.1 x diameter (what ICP and verification can take from there), and the time per
 // model and frame, under the settings given.
 //
-//   ppf_bench [--stride 2] [--reference-spacing 0.4] [--coplanar 12] [--scene-normals 30] [--spread-margin 0.5]
-//   [--frames 000001]
-//             [--results F]
+//   ppf_bench [--stride 2] [--reference-spacing 0.3] [--coplanar 12] [--scene-normals 30] [--spread-margin 0.5]
+//             [--frames 000001] [--results F]
 
 #include <CLI/CLI.hpp>
 

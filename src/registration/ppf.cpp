@@ -25,7 +25,7 @@ uint64_t VoxelKey(const Eigen::Vector3f& point, double voxel) {
 }
 
 // atan2 to within 2e-6 rad (a polynomial for atan on [0, 1] and the octants' symmetries), several times faster than
-// std::atan2: pair features take four per scene pair, and the bins they fall in are 6 degrees wide.
+// std::atan2: each scene pair takes one (its alpha), and the bins it falls in are 12 degrees wide.
 float FastAtan2(float y, float x) {
   const float ax = std::abs(x), ay = std::abs(y);
   const float big = std::max(ax, ay);
@@ -507,16 +507,20 @@ std::vector<PpfPose> FindPpfPoses(const PpfModel& model, const std::vector<Orien
                                   const std::vector<OrientedPoint>& explained, PpfSearchStats* stats) {
   const PpfOptions& options = model.options();
   const double diameter = model.diameter_m();
-  // The reference points' candidates first, then the explained points they may pair with.
+  // The open points, then the explained ones they may pair with.
   std::vector<OrientedPoint> scene =
       SubsampleByNormals(scene_points, options.sampling * diameter, options.scene_keep_normal_deg);
-  const size_t references = scene.size();
+  for (OrientedPoint& point : scene) point.normal = UnitOr(point.normal);
+  // The reference points: the open ones thinned to one per coarse voxel and differing normal, so that every surface
+  // leads votes however few points it has.
+  const std::vector<OrientedPoint> leaders =
+      SubsampleByNormals(scene, options.reference_spacing * diameter, options.scene_keep_normal_deg);
   if (!explained.empty()) {
-    const std::vector<OrientedPoint> others =
+    std::vector<OrientedPoint> others =
         SubsampleByNormals(explained, options.sampling * diameter, options.scene_keep_normal_deg);
+    for (OrientedPoint& point : others) point.normal = UnitOr(point.normal);
     scene.insert(scene.end(), others.begin(), others.end());
   }
-  for (OrientedPoint& point : scene) point.normal = UnitOr(point.normal);
   const FeatureBins bins(diameter, options);
   const CellGrid grid(scene, diameter);
   const size_t model_points = model.points().size();
@@ -531,11 +535,6 @@ std::vector<PpfPose> FindPpfPoses(const PpfModel& model, const std::vector<Orien
   constexpr uint32_t kCount = 0xffffU;
   PpfSearchStats done;
   done.scene_points = scene.size();
-  // The reference points: the open ones thinned to one per coarse voxel and differing normal, so that every surface
-  // leads votes however few points it has.
-  const std::vector<OrientedPoint> leaders(SubsampleByNormals(
-      std::vector<OrientedPoint>(scene.begin(), scene.begin() + static_cast<std::ptrdiff_t>(references)),
-      options.reference_spacing * diameter, options.scene_keep_normal_deg));
   done.references = leaders.size();
   std::vector<Lookup> lookups;  // the reference point's table look-ups, reused
   for (const OrientedPoint& reference : leaders) {
