@@ -353,8 +353,10 @@ class Recognizer::Impl {
   }
 
   // `pose`, or the best of its turns by 180 degrees about the model's principal axes (each refined by ICP when it
-  // scored rival_min_ratio of `pose`) that beats it (TwinOptions). Adds verification and ICP times.
+  // scored rival_min_ratio of `pose`) that beats it (TwinOptions); a pose below give_up_below_score is not turned.
+  // Adds verification and ICP times.
   VerifiedPose BestTwin(size_t model, const Scene& scene, VerifiedPose pose, StageTimes* times) {
+    if (pose.search_score < options_.give_up_below_score) return pose;
     const PrincipalBox& principal = models_[model].axes;
     const Detection original = pose.detection;
     const ModelSearch search = Search(model, scene, 1);
@@ -478,8 +480,9 @@ class Recognizer::Impl {
   }
 
   // The model's best point pair pose clusters among the scene's oriented `points` (the `explained` ones only paired
-  // with), each verified; those that scored rival_min_ratio of the best of them refined by ICP and verified again (the
-  // better kept): ICP is the dearest step, and a coarse pose far below the best rarely wins after it. The best of them.
+  // with), each verified; those that scored rival_min_ratio of the best of them and give_up_below_score refined by ICP
+  // and verified again (the better kept): ICP is the dearest step, and a coarse pose far below the best rarely wins
+  // after it. The best of them.
   std::optional<VerifiedPose> BestPointPairPose(size_t model, const Scene& scene,
                                                 const std::vector<OrientedPoint>& points,
                                                 const std::vector<OrientedPoint>& explained, StageTimes* times) {
@@ -501,7 +504,7 @@ class Recognizer::Impl {
     std::optional<VerifiedPose> best;
     for (size_t c = 0; c < count; ++c) {
       if (options_.refine && verified[c].search_score > 0.0 &&
-          verified[c].search_score >= options_.rival_min_ratio * best_coarse) {
+          verified[c].search_score >= std::max(options_.give_up_below_score, options_.rival_min_ratio * best_coarse)) {
         RefineIfBetter(model, scene, search, &hypotheses[c], &verified[c], times);
       }
       verified[c].detection.hypothesis_source = HypothesisSource::kPpf;
