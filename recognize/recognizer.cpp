@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <numeric>
 #include <optional>
@@ -68,8 +69,13 @@ struct LoadedModel {
   RenderOptions render;                 // shaded as its library views are
   std::optional<PpfModel> point_pairs;  // with point pair hypotheses: its table, if any
   std::string point_pair_refusal;       // without a table: why
-  bool plain = false;                   // painted in one colour alone (VerifyOptions::plain_appearance)
-  PrincipalBox axes;                    // about which its poses are turned (TwinOptions)
+  // A table of the library's stored points is built when the model first reaches the point pair stage (most models
+  // of a frame are found by the context, or never reach it): once, whichever worker gets there first.
+  bool point_pairs_deferred = false;
+  std::unique_ptr<std::once_flag> point_pairs_built = std::make_unique<std::once_flag>();
+  double diameter_m = 0.0;  // of its mesh
+  bool plain = false;       // painted in one colour alone (VerifyOptions::plain_appearance)
+  PrincipalBox axes;        // about which its poses are turned (TwinOptions)
 };
 
 RendererOptions VerificationRenderer(const RecognizerOptions& options) {
@@ -108,7 +114,8 @@ class Recognizer::Impl {
         model.render.cull_back_faces = options_.verify.cull_back_faces && meshes[i].IsClosedOutward();
         model.plain = OneColoured(meshes[i]);
         model.axes = meshes[i].PrincipalAxesBox();
-        if (point_pairs) model.point_pairs = MakePointPairModel(source.record, meshes[i], &model.point_pair_refusal);
+        model.diameter_m = meshes[i].Diameter();
+        if (point_pairs) PreparePointPairs(meshes[i], &model);
       });
       for (size_t i = 0; i < meshes.size(); ++i) models_[first + i].mesh = renderer_.AddMesh(meshes[i]);
     }
@@ -405,31 +412,49 @@ class Recognizer::Impl {
     return std::move(*best);
   }
 
-  // A model's point pair table: of its stored points when they were drawn as the options draw them, else of points
-  // drawn from its mesh now; none (`refusal` says why) when the library holds no points for it or its mesh is too
-  // small, flat or coarse for point pairs.
-  std::optional<PpfModel> MakePointPairModel(const ModelRecord& record, const TriangleMesh& mesh,
-                                             std::string* refusal) const {
+  // A model's point pair table: of its stored points when they were drawn as the options draw them (deferred to
+  // its first use: PointPairTable), else of points drawn from its mesh now; none (point_pair_refusal says why) when
+  // the library holds no points for it or its mesh is too small, flat or coarse for point pairs.
+  void PreparePointPairs(const TriangleMesh& mesh, LoadedModel* model) const {
+    const ModelRecord& record = model->record;
     if (!record.point_pairs) {
-      *refusal =
+      model->point_pair_refusal =
           "the library holds no point pair points for it: built with --no-ppf, or migrated without a stored "
           "mesh; build the model again to add them";
-      return std::nullopt;
+      return;
     }
-    const PpfOptions& options = options_.point_pairs.ppf;
-    const PpfModelSampling sampling = PpfModelSampling::Of(options, options_.point_pairs.model_samples);
-    const bool stored = record.point_pairs->sampling == sampling;
-    if (stored && !record.point_pairs->refusal.empty()) {
-      *refusal = record.point_pairs->refusal;
-      return std::nullopt;
+    const PpfModelSampling sampling =
+        PpfModelSampling::Of(options_.point_pairs.ppf, options_.point_pairs.model_samples);
+    if (record.point_pairs->sampling == sampling) {
+      if (record.point_pairs->refusal.empty()) {
+        model->point_pairs_deferred = true;
+      } else {
+        model->point_pair_refusal = record.point_pairs->refusal;
+      }
+      return;
     }
     try {
-      return PpfModel::FromSampledPoints(stored ? record.point_pairs->points : SampleModelPoints(mesh, sampling),
-                                         mesh.Diameter(), options);
+      model->point_pairs =
+          PpfModel::FromSampledPoints(SampleModelPoints(mesh, sampling), mesh.Diameter(), options_.point_pairs.ppf);
     } catch (const InputError& error) {
-      *refusal = error.what();
-      return std::nullopt;
+      model->point_pair_refusal = error.what();
     }
+  }
+
+  // The model's point pair table, built now if deferred; nullptr when it has none.
+  const PpfModel* PointPairTable(size_t m) {
+    LoadedModel& model = models_[m];
+    if (model.point_pairs_deferred) {
+      std::call_once(*model.point_pairs_built, [&] {
+        try {
+          model.point_pairs =
+              PpfModel::FromSampledPoints(model.record.point_pairs->points, model.diameter_m, options_.point_pairs.ppf);
+        } catch (const InputError& error) {
+          model.point_pair_refusal = error.what();
+        }
+      });
+    }
+    return model.point_pairs ? &*model.point_pairs : nullptr;
   }
 
   // Point pair hypotheses for every model still searched and not found (under kBoth: not found by the context), the
@@ -437,7 +462,10 @@ class Recognizer::Impl {
   void SearchByPointPairs(const Scene& scene, std::vector<ModelInFrame>* models, StageTimes* times) {
     std::vector<size_t> wanted;
     for (size_t m = 0; m < models->size(); ++m) {
-      if ((*models)[m].search && (*models)[m].instances.empty() && models_[m].point_pairs) wanted.push_back(m);
+      if ((*models)[m].search && (*models)[m].instances.empty() &&
+          (models_[m].point_pairs || models_[m].point_pairs_deferred)) {
+        wanted.push_back(m);
+      }
     }
     if (wanted.empty()) return;
     const std::vector<OrientedPoint> points =
@@ -487,7 +515,9 @@ class Recognizer::Impl {
                                                 const std::vector<OrientedPoint>& points,
                                                 const std::vector<OrientedPoint>& explained, StageTimes* times) {
     Clock::time_point stage = Clock::now();
-    const std::vector<PpfPose> poses = FindPpfPoses(*models_[model].point_pairs, points, explained);
+    const PpfModel* table = PointPairTable(model);
+    if (table == nullptr) return std::nullopt;
+    const std::vector<PpfPose> poses = FindPpfPoses(*table, points, explained);
     times->Add(Stage::kPointPairs, MillisecondsSince(stage));
     const size_t count = std::min(poses.size(), static_cast<size_t>(options_.point_pairs.clusters));
     std::vector<Hypothesis> hypotheses(count);

@@ -82,7 +82,7 @@ Acceptance ParseAcceptance(const std::string& name, const std::string& what);
 /// Shape-driven hypotheses: point pair features (registration/ppf.h) voted on the scene's depth samples (at
 /// dense_stride_px), the best pose clusters refined by ICP and verified as the context's poses are.
 struct PointPairOptions {
-  HypothesisSource source = HypothesisSource::kContext;
+  HypothesisSource source = HypothesisSource::kBoth;
   PpfOptions ppf;
   /// The scene's dominant plane (a table top) is left out of the voting when it holds at least min_share of the
   /// scene's points (remove_plane false: never).

@@ -66,8 +66,8 @@ def test_a_library_built_without_point_pairs_says_so_to_a_recognizer_that_wants_
     sugar = os.path.join(DEMO_MESHES, "004_sugar_box")
     ecvpose.build_models(db, [sugar], views=VIEWS, point_pairs=False)
     library = ecvpose.ModelLibrary.open(db)
-    assert ecvpose.Recognizer(library).point_pair_warnings == []  # context hypotheses need none
-    [warning] = ecvpose.Recognizer(library, hypotheses="both").point_pair_warnings
+    assert ecvpose.Recognizer(library, hypotheses="context").point_pair_warnings == []  # the context needs none
+    [warning] = ecvpose.Recognizer(library).point_pair_warnings  # point pairs are on by default
     assert "004_sugar_box" in warning and "--no-ppf" in warning, warning
 
     ecvpose.build_models(db, [sugar], views=VIEWS)  # built again, with them

@@ -411,8 +411,10 @@ TEST_F(YcbvLibrary, ABananaSearchedFromItsOtherEndIsTurnedAroundAndFound) {
   load.build_matchers = false;
   load.names = {"011_banana"};
   const std::vector<EvalModel> models = EvalModels(ModelLibrary::Load(library_, load));
-  const std::vector<nlohmann::json> turned = Recognize("twins", "--models 011_banana", frames);
-  const std::vector<nlohmann::json> unturned = Recognize("no_twins", "--models 011_banana --no-twins", frames);
+  // The context's poses alone: with point pairs the banana is found from its shape whichever way the context lay.
+  const std::vector<nlohmann::json> turned = Recognize("twins", "--models 011_banana --hypotheses context", frames);
+  const std::vector<nlohmann::json> unturned =
+      Recognize("no_twins", "--models 011_banana --hypotheses context --no-twins", frames);
   ASSERT_EQ(turned.size(), frames.size());
   ASSERT_EQ(unturned.size(), frames.size());
   for (size_t f = 0; f < frames.size(); ++f) {
