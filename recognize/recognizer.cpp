@@ -508,9 +508,8 @@ class Recognizer::Impl {
   }
 
   // The model's best point pair pose clusters among the scene's oriented `points` (the `explained` ones only paired
-  // with), each verified; those that scored rival_min_ratio of the best of them and give_up_below_score refined by ICP
-  // and verified again (the better kept): ICP is the dearest step, and a coarse pose far below the best rarely wins
-  // after it. The best of them.
+  // with), each verified; those that scored rival_min_ratio of the best of them refined by ICP and verified again (the
+  // better kept): ICP is the dearest step, and a coarse pose far below the best rarely wins after it. The best of them.
   std::optional<VerifiedPose> BestPointPairPose(size_t model, const Scene& scene,
                                                 const std::vector<OrientedPoint>& points,
                                                 const std::vector<OrientedPoint>& explained, StageTimes* times) {
@@ -534,7 +533,7 @@ class Recognizer::Impl {
     std::optional<VerifiedPose> best;
     for (size_t c = 0; c < count; ++c) {
       if (options_.refine && verified[c].search_score > 0.0 &&
-          verified[c].search_score >= std::max(options_.give_up_below_score, options_.rival_min_ratio * best_coarse)) {
+          verified[c].search_score >= options_.rival_min_ratio * best_coarse) {
         RefineIfBetter(model, scene, search, &hypotheses[c], &verified[c], times);
       }
       verified[c].detection.hypothesis_source = HypothesisSource::kPpf;

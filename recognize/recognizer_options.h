@@ -135,9 +135,9 @@ struct RecognizerOptions {
   /// A model's remaining views are not tried once one verifies at this score (0: try views_per_model).
   double good_enough_score = 0.5;
   /// A model whose first give_up_after_views views all verify below give_up_below_score is taken to be absent:
-  /// its remaining views are not tried (0: never give up). Not applied to a model's later instances. A pose verifying
-  /// below give_up_below_score is not turned (twins), a point pair cluster not refined by ICP: with next to none of
-  /// its surface on the frame's, that rarely makes it right, and it was most of the time spent on absent models.
+  /// its remaining views are not tried (0: never give up). Not applied to a model's later instances. A best pose
+  /// (refined) verifying below give_up_below_score is not turned (twins): with next to none of its surface on the
+  /// frame's, no turn makes it right, and the turns were most of the time spent on absent models.
   int give_up_after_views = 4;
   double give_up_below_score = 0.1;
   /// Beyond the best verified pose of a model, its best pose turned more than 90 degrees from it is refined and

@@ -113,9 +113,7 @@ void AddSearchSettings(std::vector<Setting>* table) {
       "it is taken to be absent (0: try --views-per-model views)",
       [](auto& s) -> auto& { return s.options.give_up_after_views; }));
   table->push_back(Number(
-      "give-up-score", 0, kNoMax,
-      "See --give-up-after; a pose below it is not turned (twins),\n"
-      "a point pair cluster below it not refined by ICP",
+      "give-up-score", 0, kNoMax, "See --give-up-after; a model's best pose below it is not turned (twins)",
       [](auto& s) -> auto& { return s.options.give_up_below_score; }));
   table->push_back(Count(
       "preselect", 0, kNoMax,
