@@ -441,6 +441,12 @@ class Recognizer::Impl {
     }
   }
 
+  // The points of the model's point pair table, built or deferred (0: none).
+  static size_t PointPairPoints(const LoadedModel& model) {
+    if (model.point_pairs) return model.point_pairs->points().size();
+    return model.point_pairs_deferred ? model.record.point_pairs->points.size() : 0;
+  }
+
   // The model's point pair table, built now if deferred; nullptr when it has none.
   const PpfModel* PointPairTable(size_t m) {
     LoadedModel& model = models_[m];
@@ -468,6 +474,10 @@ class Recognizer::Impl {
       }
     }
     if (wanted.empty()) return;
+    // The dearest first (a model's voting grows with its table, points squared), so that no worker is left with a
+    // long one at the end while the other waits.
+    std::stable_sort(wanted.begin(), wanted.end(),
+                     [&](size_t a, size_t b) { return PointPairPoints(models_[a]) > PointPairPoints(models_[b]); });
     const std::vector<OrientedPoint> points =
         options_.point_pairs.remove_plane
             ? WithoutDominantPlane(OrientedScenePoints(scene.organized), options_.point_pairs.plane)
