@@ -47,7 +47,8 @@ class Recognizer {
 
   /// With point pair hypotheses (RecognizerOptions::point_pairs): per model that has no point pair table, because
   /// its mesh is too small, flat or coarse for point pairs, a line naming it and why; such a model is found by the
-  /// context alone.
+  /// context alone. (A library's stored points are made a table when first needed: one refused then, under options
+  /// other than the library's, is listed from then on.)
   std::vector<std::string> PointPairWarnings() const;
 
   /// `frame`'s colour image with each detected model rendered at its pose in red, outlined, with its name.
