@@ -517,18 +517,21 @@ std::vector<PpfPose> FindPpfPoses(const PpfModel& model, const std::vector<Orien
                                   const std::vector<OrientedPoint>& explained, PpfSearchStats* stats) {
   const PpfOptions& options = model.options();
   const double diameter = model.diameter_m();
+  // Scene points sub-sampled with unit normals (pair features take unit normals).
+  auto sampled = [&](const std::vector<OrientedPoint>& points) {
+    std::vector<OrientedPoint> kept =
+        SubsampleByNormals(points, options.sampling * diameter, options.scene_keep_normal_deg);
+    for (OrientedPoint& point : kept) point.normal = UnitOr(point.normal);
+    return kept;
+  };
   // The open points, then the explained ones they may pair with.
-  std::vector<OrientedPoint> scene =
-      SubsampleByNormals(scene_points, options.sampling * diameter, options.scene_keep_normal_deg);
-  for (OrientedPoint& point : scene) point.normal = UnitOr(point.normal);
+  std::vector<OrientedPoint> scene = sampled(scene_points);
   // The reference points: the open ones thinned to one per coarse voxel and differing normal, so that every surface
   // leads votes however few points it has.
   const std::vector<OrientedPoint> leaders =
       SubsampleByNormals(scene, options.reference_spacing * diameter, options.scene_keep_normal_deg);
   if (!explained.empty()) {
-    std::vector<OrientedPoint> others =
-        SubsampleByNormals(explained, options.sampling * diameter, options.scene_keep_normal_deg);
-    for (OrientedPoint& point : others) point.normal = UnitOr(point.normal);
+    const std::vector<OrientedPoint> others = sampled(explained);
     scene.insert(scene.end(), others.begin(), others.end());
   }
   const FeatureBins bins(diameter, options);
