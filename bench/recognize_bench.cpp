@@ -17,7 +17,7 @@
 // --search-every, --confirm-every and --confirm-first.
 // --threads N (N > 1) adds a run of ours with N worker threads: the same detections (checked), its own times.
 // --bytes adds a run of ours matching with ByteNeighbours (recognize --matcher bytes; needs AVX-512 VNNI).
-// --preselect N adds a run of ours searching only the N models a quick look scores best (recognize --preselect N).
+// --preselect N adds a run of ours searching only the N models whose best views rank highest (recognize --preselect N).
 // --turned adds a run of ours on the same frames turned 180 degrees (a camera held upside down; ground truth moved).
 // --casts adds runs of ours on the same frames under changed light (white balance, gamma; ColorCasts below).
 // --track adds a run with the previous frame's detections as priors; --search-every N (N > 1) one more where
@@ -751,7 +751,7 @@ int main(int argc, char** argv) {
       },
       "Also run ours matching with ByteNeighbours (recognize --matcher bytes; needs AVX-512 VNNI)");
   AddSettingValues(app, "preselect", &methods.preselect,
-                   "Each N > 0 also runs ours searching only the N models a quick look scores best");
+                   "Each N > 0 also runs ours searching only the N models whose best views rank highest");
   AddSettingValues(app, "hypotheses", &methods.hypotheses,
                    "Also run ours with each of these sources of pose hypotheses (ppf, both; recognize --hypotheses)");
   app.add_option("--seeds", methods.seeds,
@@ -817,7 +817,7 @@ int main(int argc, char** argv) {
     for (const int preselect : methods.ours ? methods.preselect : std::vector<int>{}) {
       if (preselect <= 0) continue;
       markdown << "\nThe same searching only the " << preselect
-               << " models that a quick look scores best (`recognize --preselect " << preselect << "`):\n\n"
+               << " models whose best views rank highest (`recognize --preselect " << preselect << "`):\n\n"
                << TimingTable(libraries, Preselecting(preselect));
     }
     if (methods.ours && methods.track) {

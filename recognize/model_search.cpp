@@ -100,21 +100,6 @@ std::vector<ViewCandidate> ModelSearch::RankViews() const {
   return views;
 }
 
-int ModelSearch::QuickScore() const {
-  int quick = 0;
-  if (!scene_.matcher) return quick;
-  for (size_t v = 0; v < record_.views.size(); v += static_cast<size_t>(options_.preselect.view_stride)) {
-    const ModelView& view = record_.views[v];
-    if (view.descriptors.values.rows == 0) continue;
-    std::vector<int> rows = RankingRows(v).ranking;
-    rows.resize(std::min(rows.size(), static_cast<size_t>(options_.preselect.rows)));
-    const std::vector<Correspondence> matches =
-        Correspondences(view, CopyRows(view.descriptors, rows), options_.RankingChecks());
-    quick = std::max(quick, ConsistentSetSize(view.primitives, scene_.primitives, matches, Consistency()));
-  }
-  return quick;
-}
-
 // Gives `candidate` its correspondences, once: the nearest scene descriptor of each of its descriptors (paper: object
 // to scene). When the ranking searched as matching does (or the search is exact), only the rows it did not match are
 // searched here. They are put in the order that matching all rows at once gives (MatchOrderLess), so that RANSAC

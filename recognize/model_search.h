@@ -59,10 +59,6 @@ class ModelSearch {
   /// The model's views, best ranked first, each with the correspondences of its ranking subset of descriptors.
   std::vector<ViewCandidate> RankViews() const;
 
-  /// The pre-selection's quick score: the largest consistent set over every preselect.view_stride-th view, on the
-  /// first preselect.rows of each view's ranking rows.
-  int QuickScore() const;
-
   /// The model's best pose over its best `count` views in `ranked` (fewer once one is good enough, or when the
   /// first `give_up_after` show none at give_up_below_score; 0: never give up): RANSAC per view, each pose verified
   /// (once per view and frame, kept in `ranked`); of those not lying mostly (max_overlap) on `covered` pixels, the

@@ -73,9 +73,10 @@ struct LoadedModel {
   // of a frame are found by the context, or never reach it): once, whichever worker gets there first.
   bool point_pairs_deferred = false;
   std::unique_ptr<std::once_flag> point_pairs_built = std::make_unique<std::once_flag>();
-  double diameter_m = 0.0;  // of its mesh
-  bool plain = false;       // painted in one colour alone (VerifyOptions::plain_appearance)
-  PrincipalBox axes;        // about which its poses are turned (TwinOptions)
+  std::unique_ptr<std::once_flag> mesh_loaded = std::make_unique<std::once_flag>();  // with lazy meshes
+  double diameter_m = 0.0;                                                           // of its mesh
+  bool plain = false;  // painted in one colour alone (VerifyOptions::plain_appearance)
+  PrincipalBox axes;   // about which its poses are turned (TwinOptions)
 };
 
 RendererOptions VerificationRenderer(const RecognizerOptions& options) {
@@ -98,24 +99,21 @@ class Recognizer::Impl {
     options_.match.k = 1;
     const std::vector<LibraryModel>& library_models = library_.models();
     models_.resize(library_models.size());
-    // Colour mapping, stored meshes (or mesh files) and texture decoding on every thread, a batch of models at a time
-    // (only a batch's meshes are held at once); the GL uploads on this thread, whose GL context it is.
+    ParallelFor(models_.size(), options_.threads, [&](size_t m) {
+      models_[m].record = PreparedRecord(library_models[m]);
+      models_[m].record.mesh_blob = {};  // the copy's bytes: the library's are decoded, the renderer holds the mesh
+      models_[m].render.shading = StoredViewShading(library_models[m].record.build_options_json);
+    });
+    // A library larger than the pre-selection: each model's mesh when it is first verified (most never are).
+    lazy_meshes_ = options_.preselect.models > 0 && models_.size() > static_cast<size_t>(options_.preselect.models);
+    // Stored meshes (or mesh files) and texture decoding on every thread, a batch of models at a time (only a batch's
+    // meshes are held at once); the GL uploads on this thread, whose GL context it is.
     const size_t batch = static_cast<size_t>(options_.threads);
-    const bool point_pairs = options_.point_pairs.source != HypothesisSource::kContext;
-    for (size_t first = 0; first < models_.size(); first += batch) {
+    for (size_t first = 0; first < models_.size() && !lazy_meshes_; first += batch) {
       std::vector<TriangleMesh> meshes(std::min(batch, models_.size() - first));
       ParallelFor(meshes.size(), options_.threads, [&](size_t i) {
-        const LibraryModel& source = library_models[first + i];
-        LoadedModel& model = models_[first + i];
-        model.record = PreparedRecord(source);
-        meshes[i] = ModelMesh(source.record);
-        model.record.mesh_blob = {};  // the copy's bytes: the renderer holds the mesh
-        model.render.shading = StoredViewShading(source.record.build_options_json);
-        model.render.cull_back_faces = options_.verify.cull_back_faces && meshes[i].IsClosedOutward();
-        model.plain = OneColoured(meshes[i]);
-        model.axes = meshes[i].PrincipalAxesBox();
-        model.diameter_m = meshes[i].Diameter();
-        if (point_pairs) PreparePointPairs(meshes[i], &model);
+        meshes[i] = ModelMesh(library_models[first + i].record);
+        TakeMesh(meshes[i], &models_[first + i]);
       });
       for (size_t i = 0; i < meshes.size(); ++i) models_[first + i].mesh = renderer_.AddMesh(meshes[i]);
     }
@@ -177,9 +175,11 @@ class Recognizer::Impl {
       DescribeScene(library_.feature_settings(), options_, &scene, &times);
       result.scene_primitives = static_cast<int>(scene.primitives.size());
     }
-    if (context && options_.preselect.models > 0 && searched > options_.preselect.models) {
+    std::vector<std::vector<ViewCandidate>> ranked(models.size());  // by Preselect, if it ran
+    const bool preselected = context && options_.preselect.models > 0 && searched > options_.preselect.models;
+    if (preselected) {
       const Clock::time_point stage = Clock::now();
-      Preselect(scene, &models);
+      Preselect(scene, &models, &ranked);
       times.Add(Stage::kPreselect, MillisecondsSince(stage));
     }
     // A model's search depends on nothing of the others', so the detections do not depend on the thread count.
@@ -190,7 +190,9 @@ class Recognizer::Impl {
     std::vector<ModelSearchResult> searches(models.size());
     if (context) {
       ParallelFor(models.size(), options_.threads, [&](size_t m) {
-        if (models[m].search) searches[m] = SearchModel(m, scene, ransac_threads, &models[m]);
+        if (models[m].search) {
+          searches[m] = SearchModel(m, scene, ransac_threads, preselected ? &ranked[m] : nullptr, &models[m]);
+        }
       });
     }
     if (options_.point_pairs.source != HypothesisSource::kContext) SearchByPointPairs(scene, &models, &times);
@@ -293,32 +295,38 @@ class Recognizer::Impl {
     });
   }
 
-  // Keeps searching only the preselect.models models with the best quick scores (ModelSearch::QuickScore); ties go to
-  // the earlier model.
-  void Preselect(const Scene& scene, std::vector<ModelInFrame>* models) {
+  // Ranks every searched model's views (into `ranked`) and keeps searching only the preselect.models models whose
+  // best view ranks highest (the larger consistent set); ties go to the earlier model.
+  void Preselect(const Scene& scene, std::vector<ModelInFrame>* models,
+                 std::vector<std::vector<ViewCandidate>>* ranked) {
     std::vector<size_t> candidates;
     for (size_t m = 0; m < models->size(); ++m) {
       if ((*models)[m].search) candidates.push_back(m);
     }
-    std::vector<int> quick(candidates.size(), 0);
     ParallelFor(candidates.size(), options_.threads,
-                [&](size_t i) { quick[i] = Search(candidates[i], scene, 1).QuickScore(); });
-    std::vector<size_t> order(candidates.size());
-    std::iota(order.begin(), order.end(), 0);
-    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return quick[a] > quick[b]; });
-    for (size_t i = static_cast<size_t>(options_.preselect.models); i < order.size(); ++i) {
-      (*models)[candidates[order[i]]].search = false;
+                [&](size_t i) { (*ranked)[candidates[i]] = Search(candidates[i], scene, 1).RankViews(); });
+    const auto best = [&](size_t m) { return (*ranked)[m].empty() ? 0 : (*ranked)[m].front().score; };
+    std::stable_sort(candidates.begin(), candidates.end(), [&](size_t a, size_t b) { return best(a) > best(b); });
+    for (size_t i = static_cast<size_t>(options_.preselect.models); i < candidates.size(); ++i) {
+      (*models)[candidates[i]].search = false;
     }
   }
 
-  // View ranking, then the best pose over the ranked views for each instance up to max_instances.
-  ModelSearchResult SearchModel(size_t m, const Scene& scene, int ransac_threads, ModelInFrame* model) {
+  // View ranking (unless `preranked` holds it), then the best pose over the ranked views for each instance up to
+  // max_instances.
+  ModelSearchResult SearchModel(size_t m, const Scene& scene, int ransac_threads, std::vector<ViewCandidate>* preranked,
+                                ModelInFrame* model) {
     ModelSearchResult result;
     const ModelSearch search = Search(m, scene, ransac_threads);
-    const Clock::time_point ranking = Clock::now();
     // A view's other descriptors are matched when it is tried: views after a good enough one are not.
-    std::vector<ViewCandidate> ranked = search.RankViews();
-    result.times.Add(Stage::kRank, MillisecondsSince(ranking));
+    std::vector<ViewCandidate> ranked;
+    if (preranked != nullptr) {
+      ranked = std::move(*preranked);
+    } else {
+      const Clock::time_point ranking = Clock::now();
+      ranked = search.RankViews();
+      result.times.Add(Stage::kRank, MillisecondsSince(ranking));
+    }
     while (static_cast<int>(model->instances.size()) < model->max_instances) {
       // Once an instance is found the model is known to be in the frame: more of its views are worth trying.
       const bool first = model->instances.empty();
@@ -412,6 +420,28 @@ class Recognizer::Impl {
     return std::move(*best);
   }
 
+  // What the recognizer keeps of a model's `mesh` besides the upload: its shape and colouring, its point pairs.
+  void TakeMesh(const TriangleMesh& mesh, LoadedModel* model) const {
+    model->render.cull_back_faces = options_.verify.cull_back_faces && mesh.IsClosedOutward();
+    model->plain = OneColoured(mesh);
+    model->axes = mesh.PrincipalAxesBox();
+    model->diameter_m = mesh.Diameter();
+    if (options_.point_pairs.source != HypothesisSource::kContext) PreparePointPairs(mesh, model);
+  }
+
+  // With lazy meshes, the model's mesh decoded and uploaded now if it is not yet: once, whichever worker gets there
+  // first. Never called while render_mutex_ is held.
+  void EnsureMesh(size_t m) {
+    if (!lazy_meshes_) return;
+    LoadedModel& model = models_[m];
+    std::call_once(*model.mesh_loaded, [&] {
+      const TriangleMesh mesh = ModelMesh(library_.models()[m].record);
+      TakeMesh(mesh, &model);
+      const std::lock_guard<std::mutex> lock(render_mutex_);
+      model.mesh = renderer_.AddMesh(mesh);
+    });
+  }
+
   // A model's point pair table: of its stored points when they were drawn as the options draw them (deferred to
   // its first use: PointPairTable), else of points drawn from its mesh now; none (point_pair_refusal says why) when
   // the library holds no points for it or its mesh is too small, flat or coarse for point pairs.
@@ -441,10 +471,10 @@ class Recognizer::Impl {
     }
   }
 
-  // The points of the model's point pair table, built or deferred (0: none).
+  // The points of the model's point pair table, built, deferred or (a lazy mesh) as the library stores them (0: none).
   static size_t PointPairPoints(const LoadedModel& model) {
     if (model.point_pairs) return model.point_pairs->points().size();
-    return model.point_pairs_deferred ? model.record.point_pairs->points.size() : 0;
+    return model.record.point_pairs && model.point_pair_refusal.empty() ? model.record.point_pairs->points.size() : 0;
   }
 
   // The model's point pair table, built now if deferred; nullptr when it has none.
@@ -468,8 +498,9 @@ class Recognizer::Impl {
   void SearchByPointPairs(const Scene& scene, std::vector<ModelInFrame>* models, StageTimes* times) {
     std::vector<size_t> wanted;
     for (size_t m = 0; m < models->size(); ++m) {
+      // A lazy mesh not loaded yet: whether it has a table is known once it is (BestPointPairPose).
       if ((*models)[m].search && (*models)[m].instances.empty() &&
-          (models_[m].point_pairs || models_[m].point_pairs_deferred)) {
+          (models_[m].point_pairs || models_[m].point_pairs_deferred || lazy_meshes_)) {
         wanted.push_back(m);
       }
     }
@@ -493,6 +524,7 @@ class Recognizer::Impl {
     }
     std::vector<StageTimes> model_times(wanted.size());
     ParallelFor(wanted.size(), options_.threads, [&](size_t i) {
+      EnsureMesh(wanted[i]);
       std::optional<VerifiedPose> best = BestPointPairPose(wanted[i], scene, open, explained, &model_times[i]);
       if (best && options_.twins.enabled) best = BestTwin(wanted[i], scene, std::move(*best), &model_times[i]);
       if (best && Judge(*best, &(*models)[wanted[i]])) {
@@ -588,6 +620,7 @@ class Recognizer::Impl {
 
   // The model rendered at `pose` at the frame's dense stride (one render at a time: one GL context).
   RenderResult Render(size_t model, const Scene& scene, const Eigen::Isometry3d& pose) {
+    EnsureMesh(model);
     const PinholeCamera camera = scene.frame->camera.Sampled(options_.dense_stride_px);
     const std::lock_guard<std::mutex> lock(render_mutex_);
     return renderer_.Render(models_[model].mesh, camera, pose, models_[model].render);
@@ -665,6 +698,7 @@ class Recognizer::Impl {
   std::mutex render_mutex_;               // Verify runs on the model workers
   std::vector<LoadedModel> models_;       // in the library's order
   std::vector<std::string> model_names_;  // the same order
+  bool lazy_meshes_ = false;              // each model's mesh loaded on its first render (EnsureMesh)
 };
 
 cv::Mat Recognizer::Impl::DrawDetections(const RgbdFrame& frame, const std::vector<Detection>& detections) {
@@ -673,7 +707,9 @@ cv::Mat Recognizer::Impl::DrawDetections(const RgbdFrame& frame, const std::vect
   for (const Detection& detection : detections) {
     const auto name = std::find(model_names_.begin(), model_names_.end(), detection.model);
     if (name != model_names_.end()) {
-      objects.push_back({models_[static_cast<size_t>(name - model_names_.begin())].mesh, detection.camera_from_object});
+      const auto m = static_cast<size_t>(name - model_names_.begin());
+      EnsureMesh(m);
+      objects.push_back({models_[m].mesh, detection.camera_from_object});
       drawn.push_back(detection);
     }
   }

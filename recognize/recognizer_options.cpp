@@ -81,8 +81,6 @@ void RecognizerOptions::Check() const {
   require(ranking.max_correspondences >= 3, "ranking.max_correspondences", "at least 3");
   require(ranking.checks >= 0, "ranking.checks", "0 (match.checks) or more");
   require(preselect.models >= 0, "preselect.models", ">= 0 (0: search every model)");
-  require(preselect.view_stride >= 1, "preselect.view_stride", "at least 1");
-  require(preselect.rows >= 3, "preselect.rows", "at least 3");
   require(tracking.min_follow_score >= 0.0 && tracking.min_follow_score <= 1.0, "tracking.min_follow_score",
           "in [0, 1]");
   require(tracking.confirm_every >= 0, "tracking.confirm_every", ">= 0 (0: never)");

@@ -20,12 +20,11 @@ struct RankingOptions {
   int checks = 0;
 };
 
-/// Pre-selection of candidate models, for large libraries: each model gets a quick score, the largest consistent
-/// set over every view_stride-th view on `rows` of its ranking descriptors, and only the best `models` are searched.
+/// Pre-selection of candidate models, for large libraries: every model's views are ranked (as its search would rank
+/// them), and only the `models` models whose best view ranks highest are searched further (RANSAC, point pairs,
+/// verification), each from that ranking.
 struct PreselectOptions {
   int models = 0;  ///< models searched per frame (0: every model; tracked models are not counted)
-  int view_stride = 4;
-  int rows = 100;
 };
 
 /// Tracking between the frames of a stream (Recognizer::Recognize with priors).

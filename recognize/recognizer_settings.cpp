@@ -117,8 +117,8 @@ void AddSearchSettings(std::vector<Setting>* table) {
       [](auto& s) -> auto& { return s.options.give_up_below_score; }));
   table->push_back(Count(
       "preselect", 0, kNoMax,
-      "Search only the N models that a quick look at every 4th view (100 descriptors each) scores best:\n"
-      "for large libraries, about half the time with 6 of 16 models, at some loss of recall (0: every model)",
+      "Search only the N models whose best view ranks highest (every model's views are ranked; RANSAC,\n"
+      "point pairs and verification for those N alone): for large libraries (0: every model)",
       [](auto& s) -> auto& { return s.options.preselect.models; }));
   table->push_back(Count(
       "ranking-checks", 0, kNoMax,
