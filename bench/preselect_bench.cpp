@@ -45,9 +45,13 @@ std::vector<std::string> Ranked(const std::map<std::string, int>& best, const st
 }
 
 // Each model's best view score (RankedView::score, its ranking's consistent set).
-std::map<std::string, int> BestViewScores(Recognizer* recognizer, const RgbdFrame& frame) {
+std::map<std::string, int> BestViewScores(Recognizer* recognizer, const RgbdFrame& frame,
+                                          std::map<std::string, std::vector<int>>* all) {
   std::map<std::string, int> best;
-  for (const auto& [model, views] : recognizer->RankViews(frame)) best[model] = views.empty() ? 0 : views.front().score;
+  for (const auto& [model, views] : recognizer->RankViews(frame)) {
+    best[model] = views.empty() ? 0 : views.front().score;
+    for (const RankedView& view : views) (*all)[model].push_back(view.score);
+  }
   return best;
 }
 
@@ -62,7 +66,8 @@ LibraryRun Run(const std::string& db, const RecognizerOptions& options, const st
   for (const LibraryModel& model : library.models()) names.push_back(model.record.name);
   for (const LoadedFrame& frame : frames) {
     const Clock::time_point start = Clock::now();
-    const std::map<std::string, int> evidence = BestViewScores(&recognizer, frame.rgbd);
+    std::map<std::string, std::vector<int>> all;
+    const std::map<std::string, int> evidence = BestViewScores(&recognizer, frame.rgbd, &all);
     run.ms.push_back(MillisecondsSince(start));
     const std::vector<std::string> order = Ranked(evidence, names);
     std::string video = std::to_string(frame.scene_id);
@@ -79,7 +84,9 @@ LibraryRun Run(const std::string& db, const RecognizerOptions& options, const st
     if (csv != nullptr && csv->is_open()) {
       for (size_t r = 0; r < order.size(); ++r) {
         *csv << run.name << "," << frame.rgbd.name << "," << order[r] << "," << (present[order[r]] ? 1 : 0) << "," << r
-             << "," << evidence.at(order[r]) << "\n";
+             << "," << evidence.at(order[r]);
+        for (const int score : all[order[r]]) *csv << "," << score;
+        *csv << "\n";
       }
     }
     std::cerr << "preselect_bench: " << run.name << " " << frame.rgbd.name << " " << Fixed(run.ms.back(), 0) << " ms\n";

@@ -7,7 +7,7 @@
 // Replaces its section of bench/RESULTS.md (bench_util ReportSection).
 //
 //   scripts/build_ycbv_library /tmp/ycbv.sqlite --views 40 --distance 0.9
-//   setup_bench --db /tmp/ycbv.sqlite [--frame YCBV_PREFIX] [--rounds 3] [--threads 2] [--work DIR]
+//   setup_bench --db /tmp/ycbv.sqlite [--frame YCBV_PREFIX] [--rounds 3] [--threads 2] [--preselect N] [--work DIR]
 //               [--results FILE]
 
 #include <CLI/CLI.hpp>
@@ -41,6 +41,7 @@ struct Settings {
   std::string frame = std::string(ECV_DATA_DIR) + "/ycbv_subset/Example-Scenes/0001/000001";
   int rounds = 3;
   int threads = 2;
+  int preselect = 0;  // RecognizerOptions::preselect.models (meshes then loaded on first use)
   std::string work = "/tmp/setup_bench";
   std::string results = std::string(ECV_SOURCE_DIR) + "/bench/RESULTS.md";
   std::string command = "setup_bench";
@@ -91,6 +92,7 @@ void RunVariant(const Settings& settings, const std::string& path, const ecv::Lo
   times->meshes.push_back(MillisecondsSince(start));
   ecv::RecognizerOptions options;
   options.threads = settings.threads;
+  options.preselect.models = settings.preselect;
   start = Clock::now();
   ecv::Recognizer recognizer(library, options);
   times->setup.push_back(MillisecondsSince(start));
@@ -132,6 +134,9 @@ int main(int argc, char** argv) {
   app.add_option("--threads", settings.threads, "Recognizer threads")
       ->check(ecv::bench::AtLeastOne())
       ->capture_default_str();
+  app.add_option("--preselect", settings.preselect,
+                 "Models searched per frame (recognize --preselect; a larger library's meshes then load on first use)")
+      ->capture_default_str();
   app.add_option("--work", settings.work, "Directory for the library copy without meshes")->capture_default_str();
   app.add_option("--results", settings.results, "Markdown file whose section of this bench the report replaces")
       ->capture_default_str();
@@ -169,8 +174,11 @@ int main(int argc, char** argv) {
         settings.frame + "`, the same with either variant), " + std::to_string(settings.rounds) +
         " rounds, the variants alternated; medians. read = `ModelLibrary::Load` without matchers (as `recognize`); "
         "meshes = every model's mesh decoded on one thread (`ModelMesh`); set-up = `Recognizer` made with " +
-        std::to_string(settings.threads) +
-        " threads (meshes decoded and uploaded for verification); frame = the first `Recognize`; eval = "
+        std::to_string(settings.threads) + " threads (meshes decoded and uploaded for verification" +
+        (settings.preselect > 0
+             ? ", unless `--preselect " + std::to_string(settings.preselect) + "` loads them on first use, in the frame"
+             : std::string()) +
+        "); frame = the first `Recognize`; eval = "
         "`EvalModels` (geometry for ADD). \"from files\" is the same library with its `meshes` rows deleted (and "
         "vacuumed), so that each model reads its `mesh_path` as before schema 2.\n\n"
         "| meshes | library MB | read ms | meshes ms | set-up ms | frame ms | read + set-up + frame ms | eval ms |\n"

@@ -202,8 +202,9 @@ TEST_F(RecognizeEndToEnd, TheLearnedAcceptanceFindsTheDemoFramesObjects) {
 // The speed options: exact matching over 7-bit descriptors (plain loop or VNNI, the same matches) and view ranking
 // with fewer checks still find the demo frame's three objects; an unknown matcher is named.
 // Pre-selection (PreselectOptions::models): of the three models, all in the frame, exactly the two
-// kept are searched, both found at their true poses and nothing else reported; keeping as many as there are
-// models changes nothing. A negative count is refused, naming the option.
+// kept are searched, both found at their true poses and nothing else reported, and the third's mesh, loaded on
+// first use, draws as a mesh loaded up front; keeping as many as there are models changes nothing. A negative count
+// is refused, naming the option.
 TEST_F(RecognizeEndToEnd, PreselectionSearchesOnlyTheBestScoringModels) {
   const LoadedFrame frame = LoadYcbvFrame(Frame());
   const ModelLibrary library = Library();
@@ -224,7 +225,14 @@ TEST_F(RecognizeEndToEnd, PreselectionSearchesOnlyTheBestScoringModels) {
 
   options.preselect.models = 3;
   const RecognitionResult all = Recognizer(library, options).Recognize(frame.rgbd);
-  const RecognitionResult plain = Recognizer(library).Recognize(frame.rgbd);
+  Recognizer plain_recognizer(library);
+  const RecognitionResult plain = plain_recognizer.Recognize(frame.rgbd);
+  // The pre-selecting recognizer loads a mesh when first needed: the model it did not search draws as it does
+  // loaded up front.
+  const cv::Mat lazy = preselecting.DrawDetections(frame.rgbd, plain.detections);
+  const cv::Mat eager = plain_recognizer.DrawDetections(frame.rgbd, plain.detections);
+  ASSERT_EQ(lazy.size(), eager.size());
+  EXPECT_EQ(cv::norm(lazy, eager, cv::NORM_INF), 0.0);
   EXPECT_EQ(all.views_tried, plain.views_tried);
   EXPECT_EQ(all.timings_ms.count("preselect"), 0U);
   ASSERT_EQ(all.detections.size(), plain.detections.size());
