@@ -41,7 +41,7 @@ struct Settings {
   std::string frame = std::string(ECV_DATA_DIR) + "/ycbv_subset/Example-Scenes/0001/000001";
   int rounds = 3;
   int threads = 2;
-  int preselect = 0;  // RecognizerOptions::preselect.models (meshes then loaded on first use)
+  int preselect = ecv::RecognizerOptions().preselect.models;  // searched models per frame (lazy meshes beyond)
   std::string work = "/tmp/setup_bench";
   std::string results = std::string(ECV_SOURCE_DIR) + "/bench/RESULTS.md";
   std::string command = "setup_bench";

@@ -175,11 +175,9 @@ class Recognizer::Impl {
       DescribeScene(library_.feature_settings(), options_, &scene, &times);
       result.scene_primitives = static_cast<int>(scene.primitives.size());
     }
-    std::vector<std::vector<ViewCandidate>> ranked(models.size());  // by Preselect, if it ran
-    const bool preselected = context && options_.preselect.models > 0 && searched > options_.preselect.models;
-    if (preselected) {
+    if (context && options_.preselect.models > 0 && searched > options_.preselect.models) {
       const Clock::time_point stage = Clock::now();
-      Preselect(scene, &models, &ranked);
+      Preselect(scene, &models);
       times.Add(Stage::kPreselect, MillisecondsSince(stage));
     }
     // A model's search depends on nothing of the others', so the detections do not depend on the thread count.
@@ -191,7 +189,7 @@ class Recognizer::Impl {
     if (context) {
       ParallelFor(models.size(), options_.threads, [&](size_t m) {
         if (models[m].search) {
-          searches[m] = SearchModel(m, scene, ransac_threads, preselected ? &ranked[m] : nullptr, &models[m]);
+          searches[m] = SearchModel(m, scene, ransac_threads, &models[m]);
         }
       });
     }
@@ -295,38 +293,39 @@ class Recognizer::Impl {
     });
   }
 
-  // Ranks every searched model's views (into `ranked`) and keeps searching only the preselect.models models whose
-  // best view ranks highest (the larger consistent set); ties go to the earlier model.
-  void Preselect(const Scene& scene, std::vector<ModelInFrame>* models,
-                 std::vector<std::vector<ViewCandidate>>* ranked) {
+  // Ranks every searched model's views quickly (PreselectOptions::rows and checks) and keeps searching only the
+  // preselect.models models whose best view ranks highest (the larger consistent set); ties go to the earlier model.
+  void Preselect(const Scene& scene, std::vector<ModelInFrame>* models) {
+    RecognizerOptions quick = options_;
+    quick.ranking.max_correspondences = options_.preselect.rows;
+    quick.ranking.checks = options_.preselect.checks;
     std::vector<size_t> candidates;
     for (size_t m = 0; m < models->size(); ++m) {
       if ((*models)[m].search) candidates.push_back(m);
     }
-    ParallelFor(candidates.size(), options_.threads,
-                [&](size_t i) { (*ranked)[candidates[i]] = Search(candidates[i], scene, 1).RankViews(); });
-    const auto best = [&](size_t m) { return (*ranked)[m].empty() ? 0 : (*ranked)[m].front().score; };
-    std::stable_sort(candidates.begin(), candidates.end(), [&](size_t a, size_t b) { return best(a) > best(b); });
+    std::vector<int> best(models->size(), 0);
+    ParallelFor(candidates.size(), options_.threads, [&](size_t i) {
+      const size_t m = candidates[i];
+      const std::vector<ViewCandidate> ranked =
+          ModelSearch(
+              models_[m].record, quick, scene, [](const Hypothesis&) { return VerifiedPose(); }, 1)
+              .RankViews();
+      best[m] = ranked.empty() ? 0 : ranked.front().score;
+    });
+    std::stable_sort(candidates.begin(), candidates.end(), [&](size_t a, size_t b) { return best[a] > best[b]; });
     for (size_t i = static_cast<size_t>(options_.preselect.models); i < candidates.size(); ++i) {
       (*models)[candidates[i]].search = false;
     }
   }
 
-  // View ranking (unless `preranked` holds it), then the best pose over the ranked views for each instance up to
-  // max_instances.
-  ModelSearchResult SearchModel(size_t m, const Scene& scene, int ransac_threads, std::vector<ViewCandidate>* preranked,
-                                ModelInFrame* model) {
+  // View ranking, then the best pose over the ranked views for each instance up to max_instances.
+  ModelSearchResult SearchModel(size_t m, const Scene& scene, int ransac_threads, ModelInFrame* model) {
     ModelSearchResult result;
     const ModelSearch search = Search(m, scene, ransac_threads);
+    const Clock::time_point ranking = Clock::now();
     // A view's other descriptors are matched when it is tried: views after a good enough one are not.
-    std::vector<ViewCandidate> ranked;
-    if (preranked != nullptr) {
-      ranked = std::move(*preranked);
-    } else {
-      const Clock::time_point ranking = Clock::now();
-      ranked = search.RankViews();
-      result.times.Add(Stage::kRank, MillisecondsSince(ranking));
-    }
+    std::vector<ViewCandidate> ranked = search.RankViews();
+    result.times.Add(Stage::kRank, MillisecondsSince(ranking));
     while (static_cast<int>(model->instances.size()) < model->max_instances) {
       // Once an instance is found the model is known to be in the frame: more of its views are worth trying.
       const bool first = model->instances.empty();

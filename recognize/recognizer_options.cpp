@@ -81,6 +81,8 @@ void RecognizerOptions::Check() const {
   require(ranking.max_correspondences >= 3, "ranking.max_correspondences", "at least 3");
   require(ranking.checks >= 0, "ranking.checks", "0 (match.checks) or more");
   require(preselect.models >= 0, "preselect.models", ">= 0 (0: search every model)");
+  require(preselect.rows >= 3, "preselect.rows", "at least 3");
+  require(preselect.checks >= 0, "preselect.checks", "0 (match.checks) or more");
   require(tracking.min_follow_score >= 0.0 && tracking.min_follow_score <= 1.0, "tracking.min_follow_score",
           "in [0, 1]");
   require(tracking.confirm_every >= 0, "tracking.confirm_every", ">= 0 (0: never)");

@@ -20,11 +20,16 @@ struct RankingOptions {
   int checks = 0;
 };
 
-/// Pre-selection of candidate models, for large libraries: every model's views are ranked (as its search would rank
-/// them), and only the `models` models whose best view ranks highest are searched further (RANSAC, point pairs,
-/// verification), each from that ranking.
+/// Pre-selection of candidate models, for large libraries: every model's views are ranked quickly (fewer descriptors
+/// per view, fewer checks than the search's ranking), and only the `models` models whose best view ranks highest are
+/// searched (ranking, RANSAC, point pairs, verification). A library of more models loads each mesh when it is first
+/// verified.
 struct PreselectOptions {
-  int models = 0;  ///< models searched per frame (0: every model; tracked models are not counted)
+  /// Models searched per frame (0: every model; tracked models are not counted). So that a large library costs
+  /// about what a 16-model one does beyond the quick ranking, and its distractors cannot all be tried.
+  int models = 16;
+  int rows = 100;   ///< descriptors of each view ranked (a seeded random subset, as the search's ranking takes)
+  int checks = 32;  ///< descriptors compared per query (0: MatchOptions::checks)
 };
 
 /// Tracking between the frames of a stream (Recognizer::Recognize with priors).
