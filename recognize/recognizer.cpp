@@ -4,7 +4,6 @@
 #include <map>
 #include <memory>
 #include <mutex>
-#include <numeric>
 #include <optional>
 
 #include <opencv2/imgproc.hpp>
@@ -73,10 +72,11 @@ struct LoadedModel {
   // of a frame are found by the context, or never reach it): once, whichever worker gets there first.
   bool point_pairs_deferred = false;
   std::unique_ptr<std::once_flag> point_pairs_built = std::make_unique<std::once_flag>();
-  std::unique_ptr<std::once_flag> mesh_loaded = std::make_unique<std::once_flag>();  // with lazy meshes
-  double diameter_m = 0.0;                                                           // of its mesh
-  bool plain = false;  // painted in one colour alone (VerifyOptions::plain_appearance)
-  PrincipalBox axes;   // about which its poses are turned (TwinOptions)
+  // With lazy meshes (a pre-selected library), its mesh is loaded when first needed: EnsureMesh.
+  std::unique_ptr<std::once_flag> mesh_loaded = std::make_unique<std::once_flag>();
+  double diameter_m = 0.0;  // of its mesh
+  bool plain = false;       // painted in one colour alone (VerifyOptions::plain_appearance)
+  PrincipalBox axes;        // about which its poses are turned (TwinOptions)
 };
 
 RendererOptions VerificationRenderer(const RecognizerOptions& options) {
@@ -188,9 +188,7 @@ class Recognizer::Impl {
     std::vector<ModelSearchResult> searches(models.size());
     if (context) {
       ParallelFor(models.size(), options_.threads, [&](size_t m) {
-        if (models[m].search) {
-          searches[m] = SearchModel(m, scene, ransac_threads, &models[m]);
-        }
+        if (models[m].search) searches[m] = SearchModel(m, scene, ransac_threads, &models[m]);
       });
     }
     if (options_.point_pairs.source != HypothesisSource::kContext) SearchByPointPairs(scene, &models, &times);
@@ -306,10 +304,8 @@ class Recognizer::Impl {
     std::vector<int> best(models->size(), 0);
     ParallelFor(candidates.size(), options_.threads, [&](size_t i) {
       const size_t m = candidates[i];
-      const std::vector<ViewCandidate> ranked =
-          ModelSearch(
-              models_[m].record, quick, scene, [](const Hypothesis&) { return VerifiedPose(); }, 1)
-              .RankViews();
+      const ModelSearch search(models_[m].record, quick, scene, nullptr, 1);  // ranking only: nothing verified
+      const std::vector<ViewCandidate> ranked = search.RankViews();
       best[m] = ranked.empty() ? 0 : ranked.front().score;
     });
     std::stable_sort(candidates.begin(), candidates.end(), [&](size_t a, size_t b) { return best[a] > best[b]; });
