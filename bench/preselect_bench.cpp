@@ -46,15 +46,14 @@ std::vector<std::string> Ranked(const std::map<std::string, int>& best, const st
   return order;
 }
 
-// Each model's best view score (RankedView::score, its ranking's consistent set).
-std::map<std::string, int> BestViewScores(Recognizer* recognizer, const RgbdFrame& frame,
-                                          std::map<std::string, std::vector<int>>* all) {
-  std::map<std::string, int> best;
+// Each model's view scores (RankedView::score, its ranking's consistent set), best first.
+std::map<std::string, std::vector<int>> ViewScores(Recognizer* recognizer, const RgbdFrame& frame) {
+  std::map<std::string, std::vector<int>> scores;
   for (const auto& [model, views] : recognizer->RankViews(frame)) {
-    best[model] = views.empty() ? 0 : views.front().score;
-    for (const RankedView& view : views) (*all)[model].push_back(view.score);
+    std::vector<int>& model_scores = scores[model];
+    for (const RankedView& view : views) model_scores.push_back(view.score);
   }
-  return best;
+  return scores;
 }
 
 LibraryRun Run(const std::string& db, const RecognizerOptions& options, const std::vector<LoadedFrame>& frames,
@@ -68,9 +67,10 @@ LibraryRun Run(const std::string& db, const RecognizerOptions& options, const st
   for (const LibraryModel& model : library.models()) names.push_back(model.record.name);
   for (const LoadedFrame& frame : frames) {
     const Clock::time_point start = Clock::now();
-    std::map<std::string, std::vector<int>> all;
-    const std::map<std::string, int> evidence = BestViewScores(&recognizer, frame.rgbd, &all);
+    const std::map<std::string, std::vector<int>> all = ViewScores(&recognizer, frame.rgbd);
     run.ms.push_back(MillisecondsSince(start));
+    std::map<std::string, int> evidence;  // each model's best view score
+    for (const auto& [model, scores] : all) evidence[model] = scores.empty() ? 0 : scores.front();
     const std::vector<std::string> order = Ranked(evidence, names);
     std::string video = std::to_string(frame.scene_id);
     video.insert(0, 4 - std::min<size_t>(4, video.size()), '0');
@@ -87,7 +87,7 @@ LibraryRun Run(const std::string& db, const RecognizerOptions& options, const st
       for (size_t r = 0; r < order.size(); ++r) {
         *csv << run.name << "," << frame.rgbd.name << "," << order[r] << "," << (present[order[r]] ? 1 : 0) << "," << r
              << "," << evidence.at(order[r]);
-        for (const int score : all[order[r]]) *csv << "," << score;
+        for (const int score : all.at(order[r])) *csv << "," << score;
         *csv << "\n";
       }
     }

@@ -103,6 +103,7 @@ class Recognizer::Impl {
       models_[m].record = PreparedRecord(library_models[m]);
       models_[m].record.mesh_blob = {};  // the copy's bytes: the library's are decoded, the renderer holds the mesh
       models_[m].render.shading = StoredViewShading(library_models[m].record.build_options_json);
+      if (options_.point_pairs.source != HypothesisSource::kContext) PreparePointPairs(&models_[m]);
     });
     // A library larger than the pre-selection: each model's mesh when it is first verified (most never are).
     lazy_meshes_ = options_.preselect.models > 0 && models_.size() > static_cast<size_t>(options_.preselect.models);
@@ -421,7 +422,9 @@ class Recognizer::Impl {
     model->plain = OneColoured(mesh);
     model->axes = mesh.PrincipalAxesBox();
     model->diameter_m = mesh.Diameter();
-    if (options_.point_pairs.source != HypothesisSource::kContext) PreparePointPairs(mesh, model);
+    if (options_.point_pairs.source != HypothesisSource::kContext && NeedsMeshPointPairs(*model)) {
+      MeshPointPairs(mesh, model);
+    }
   }
 
   // With lazy meshes, the model's mesh decoded and uploaded now if it is not yet: once, whichever worker gets there
@@ -437,39 +440,50 @@ class Recognizer::Impl {
     });
   }
 
-  // A model's point pair table: of its stored points when they were drawn as the options draw them (deferred to
-  // its first use: PointPairTable), else of points drawn from its mesh now; none (point_pair_refusal says why) when
-  // the library holds no points for it or its mesh is too small, flat or coarse for point pairs.
-  void PreparePointPairs(const TriangleMesh& mesh, LoadedModel* model) const {
+  // A model's point pair table as far as its library record decides it, at load: of its stored points when they were
+  // drawn as the options draw them (deferred to its first use: PointPairTable); none (point_pair_refusal says why)
+  // when the library holds no points for it or refused them; otherwise left to its mesh (MeshPointPairs).
+  void PreparePointPairs(LoadedModel* model) const {
     const ModelRecord& record = model->record;
     if (!record.point_pairs) {
       model->point_pair_refusal =
           "the library holds no point pair points for it: built with --no-ppf, or migrated without a stored "
           "mesh; build the model again to add them";
-      return;
-    }
-    const PpfModelSampling sampling =
-        PpfModelSampling::Of(options_.point_pairs.ppf, options_.point_pairs.model_samples);
-    if (record.point_pairs->sampling == sampling) {
+    } else if (record.point_pairs->sampling == PointPairSampling()) {
       if (record.point_pairs->refusal.empty()) {
         model->point_pairs_deferred = true;
       } else {
         model->point_pair_refusal = record.point_pairs->refusal;
       }
-      return;
     }
+  }
+
+  // The point pair sampling of the options.
+  PpfModelSampling PointPairSampling() const {
+    return PpfModelSampling::Of(options_.point_pairs.ppf, options_.point_pairs.model_samples);
+  }
+
+  // Whether the model's point pair table has to be drawn from its mesh (PreparePointPairs left it undecided).
+  static bool NeedsMeshPointPairs(const LoadedModel& model) {
+    return model.record.point_pairs && !model.point_pairs_deferred && model.point_pair_refusal.empty() &&
+           !model.point_pairs;
+  }
+
+  // A table of points drawn from the model's `mesh` now (NeedsMeshPointPairs); the refusal kept when it is too
+  // small, flat or coarse for point pairs.
+  void MeshPointPairs(const TriangleMesh& mesh, LoadedModel* model) const {
     try {
-      model->point_pairs =
-          PpfModel::FromSampledPoints(SampleModelPoints(mesh, sampling), mesh.Diameter(), options_.point_pairs.ppf);
+      model->point_pairs = PpfModel::FromSampledPoints(SampleModelPoints(mesh, PointPairSampling()), mesh.Diameter(),
+                                                       options_.point_pairs.ppf);
     } catch (const InputError& error) {
       model->point_pair_refusal = error.what();
     }
   }
 
-  // The points of the model's point pair table, built, deferred or (a lazy mesh) as the library stores them (0: none).
+  // The points of the model's point pair table, built or deferred (0: none, or not drawn yet).
   static size_t PointPairPoints(const LoadedModel& model) {
     if (model.point_pairs) return model.point_pairs->points().size();
-    return model.record.point_pairs && model.point_pair_refusal.empty() ? model.record.point_pairs->points.size() : 0;
+    return model.point_pairs_deferred ? model.record.point_pairs->points.size() : 0;
   }
 
   // The model's point pair table, built now if deferred; nullptr when it has none.
@@ -493,9 +507,9 @@ class Recognizer::Impl {
   void SearchByPointPairs(const Scene& scene, std::vector<ModelInFrame>* models, StageTimes* times) {
     std::vector<size_t> wanted;
     for (size_t m = 0; m < models->size(); ++m) {
-      // A lazy mesh not loaded yet: whether it has a table is known once it is (BestPointPairPose).
+      // A lazy mesh not loaded yet whose table is to be drawn from it: known once it is (BestPointPairPose).
       if ((*models)[m].search && (*models)[m].instances.empty() &&
-          (models_[m].point_pairs || models_[m].point_pairs_deferred || lazy_meshes_)) {
+          (models_[m].point_pairs || models_[m].point_pairs_deferred || NeedsMeshPointPairs(models_[m]))) {
         wanted.push_back(m);
       }
     }
