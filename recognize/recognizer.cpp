@@ -72,6 +72,9 @@ struct LoadedModel {
   // of a frame are found by the context, or never reach it): once, whichever worker gets there first.
   bool point_pairs_deferred = false;
   std::unique_ptr<std::once_flag> point_pairs_built = std::make_unique<std::once_flag>();
+  // A coarse table of its stored points, voted when it is a shape candidate (PreselectOptions::shape_models).
+  std::optional<PpfModel> coarse_pairs;
+  std::unique_ptr<std::once_flag> coarse_built = std::make_unique<std::once_flag>();
   // With lazy meshes (a pre-selected library), its mesh is loaded when first needed: EnsureMesh.
   std::unique_ptr<std::once_flag> mesh_loaded = std::make_unique<std::once_flag>();
   double diameter_m = 0.0;  // of its mesh
@@ -176,9 +179,10 @@ class Recognizer::Impl {
       DescribeScene(library_.feature_settings(), options_, &scene, &times);
       result.scene_primitives = static_cast<int>(scene.primitives.size());
     }
+    std::vector<size_t> left_out;  // by the pre-selection, best ranked first
     if (context && options_.preselect.models > 0 && searched > options_.preselect.models) {
       const Clock::time_point stage = Clock::now();
-      Preselect(scene, &models);
+      left_out = Preselect(scene, &models);
       times.Add(Stage::kPreselect, MillisecondsSince(stage));
     }
     // A model's search depends on nothing of the others', so the detections do not depend on the thread count.
@@ -192,7 +196,7 @@ class Recognizer::Impl {
         if (models[m].search) searches[m] = SearchModel(m, scene, ransac_threads, &models[m]);
       });
     }
-    if (options_.point_pairs.source != HypothesisSource::kContext) SearchByPointPairs(scene, &models, &times);
+    if (options_.point_pairs.source != HypothesisSource::kContext) SearchByPointPairs(scene, left_out, &models, &times);
     std::vector<VerifiedPose> candidates;
     for (size_t m = 0; m < models.size(); ++m) {
       MergeConfirmation(frame.depth.size(), options_.max_overlap, options_.max_instances, options_.dense_stride_px,
@@ -294,7 +298,8 @@ class Recognizer::Impl {
 
   // Ranks every searched model's views quickly (PreselectOptions::rows and checks) and keeps searching only the
   // preselect.models models whose best view ranks highest (the larger consistent set); ties go to the earlier model.
-  void Preselect(const Scene& scene, std::vector<ModelInFrame>* models) {
+  // The models left out, best ranked first.
+  std::vector<size_t> Preselect(const Scene& scene, std::vector<ModelInFrame>* models) {
     RecognizerOptions quick = options_;
     quick.ranking.max_correspondences = options_.preselect.rows;
     quick.ranking.checks = options_.preselect.checks;
@@ -310,9 +315,9 @@ class Recognizer::Impl {
       best[m] = ranked.empty() ? 0 : ranked.front().score;
     });
     std::stable_sort(candidates.begin(), candidates.end(), [&](size_t a, size_t b) { return best[a] > best[b]; });
-    for (size_t i = static_cast<size_t>(options_.preselect.models); i < candidates.size(); ++i) {
-      (*models)[candidates[i]].search = false;
-    }
+    const auto kept = static_cast<std::ptrdiff_t>(options_.preselect.models);
+    for (auto m = candidates.begin() + kept; m != candidates.end(); ++m) (*models)[*m].search = false;
+    return {candidates.begin() + kept, candidates.end()};
   }
 
   // View ranking, then the best pose over the ranked views for each instance up to max_instances.
@@ -502,9 +507,12 @@ class Recognizer::Impl {
     return model.point_pairs ? &*model.point_pairs : nullptr;
   }
 
-  // Point pair hypotheses for every model still searched and not found (under kBoth: not found by the context), the
-  // models on the workers. Adds the workers' times: voting (point_pairs), verification and ICP.
-  void SearchByPointPairs(const Scene& scene, std::vector<ModelInFrame>* models, StageTimes* times) {
+  // Point pair hypotheses for every model still searched and not found (under kBoth: not found by the context), and
+  // for the shape candidates among the models `left_out` by the pre-selection (ShapeCandidates); the models on the
+  // workers. Adds the workers' times: voting (point_pairs), verification and ICP.
+  void SearchByPointPairs(const Scene& scene, const std::vector<size_t>& left_out, std::vector<ModelInFrame>* models,
+                          StageTimes* times) {
+    const bool shapes = options_.preselect.shape_models > 0 && !left_out.empty();
     std::vector<size_t> wanted;
     for (size_t m = 0; m < models->size(); ++m) {
       // A lazy mesh not loaded yet whose table is to be drawn from it: known once it is (BestPointPairPose).
@@ -513,11 +521,7 @@ class Recognizer::Impl {
         wanted.push_back(m);
       }
     }
-    if (wanted.empty()) return;
-    // The dearest first (a model's voting grows with its table, points squared), so that no worker is left with a
-    // long one at the end while the other waits.
-    std::stable_sort(wanted.begin(), wanted.end(),
-                     [&](size_t a, size_t b) { return PointPairPoints(models_[a]) > PointPairPoints(models_[b]); });
+    if (wanted.empty() && !shapes) return;
     const std::vector<OrientedPoint> points =
         options_.point_pairs.remove_plane
             ? WithoutDominantPlane(OrientedScenePoints(scene.organized), options_.point_pairs.plane)
@@ -531,6 +535,18 @@ class Recognizer::Impl {
       const bool inside = u >= 0 && v >= 0 && u < taken.cols && v < taken.rows;
       (inside && taken.at<uchar>(v, u) != 0 ? explained : open).push_back(point);
     }
+    if (shapes) {
+      const Clock::time_point stage = Clock::now();
+      for (const size_t m : ShapeCandidates(left_out, open)) {
+        (*models)[m].search = true;
+        wanted.push_back(m);
+      }
+      times->Add(Stage::kPointPairs, MillisecondsSince(stage));
+    }
+    // The dearest first (a model's voting grows with its table, points squared), so that no worker is left with a
+    // long one at the end while the other waits.
+    std::stable_sort(wanted.begin(), wanted.end(),
+                     [&](size_t a, size_t b) { return PointPairPoints(models_[a]) > PointPairPoints(models_[b]); });
     std::vector<StageTimes> model_times(wanted.size());
     ParallelFor(wanted.size(), options_.threads, [&](size_t i) {
       EnsureMesh(wanted[i]);
@@ -541,6 +557,53 @@ class Recognizer::Impl {
       }
     });
     for (const StageTimes& model : model_times) *times += model;
+  }
+
+  // Of the models `left_out` by the pre-selection, the shape_models whose coarse point pair table (CoarseTable)
+  // gathers the most votes among the `open` scene points (those of no detection), most first; none without votes.
+  // Votes per point of the table: a larger or busier model gathers more on any surface.
+  std::vector<size_t> ShapeCandidates(const std::vector<size_t>& left_out, const std::vector<OrientedPoint>& open) {
+    // Thinned once for all models to a 4 mm voxel (each sub-samples them again at its own coarse voxel).
+    constexpr double kThinVoxelM = 0.004;
+    const std::vector<OrientedPoint> thinned =
+        SubsampleByNormals(open, kThinVoxelM, options_.point_pairs.ppf.keep_normal_deg);
+    std::vector<double> votes(left_out.size(), 0.0);  // per table point
+    ParallelFor(left_out.size(), options_.threads, [&](size_t i) {
+      const PpfModel* table = CoarseTable(left_out[i]);
+      if (table == nullptr) return;
+      const std::vector<PpfPose> poses = FindPpfPoses(*table, thinned);
+      if (!poses.empty()) votes[i] = poses.front().votes / static_cast<double>(table->points().size());
+    });
+    std::vector<size_t> order(left_out.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return votes[a] > votes[b]; });
+    std::vector<size_t> chosen;
+    for (const size_t i : order) {
+      if (static_cast<int>(chosen.size()) == options_.preselect.shape_models || votes[i] <= 0.0) break;
+      chosen.push_back(left_out[i]);
+    }
+    return chosen;
+  }
+
+  // A coarse point pair table of the model's stored points, to rank models by: twice the voxel and distance bin of
+  // its own table (about a quarter of its points, a sixteenth of its pairs), 100 reference points voting. Built on
+  // first use, once; nullptr when the model has no stored points or too few for a table.
+  const PpfModel* CoarseTable(size_t m) {
+    LoadedModel& model = models_[m];
+    std::call_once(*model.coarse_built, [&] {
+      const std::optional<PointPairRecord>& stored = model.record.point_pairs;
+      if (!stored || !stored->refusal.empty() || stored->points.empty()) return;
+      PpfOptions coarse = options_.point_pairs.ppf;
+      coarse.sampling = std::min(0.5, 2.0 * coarse.sampling);
+      coarse.distance_step = std::min(0.5, 2.0 * coarse.distance_step);
+      coarse.max_references = 100;
+      try {
+        model.coarse_pairs = PpfModel(stored->points, model.record.diameter_m, coarse);
+      } catch (const InputError&) {
+        // too few points or pairs at this voxel: not a shape candidate
+      }
+    });
+    return model.coarse_pairs ? &*model.coarse_pairs : nullptr;
   }
 
   // The pixels of the frame (`size`) on the rendered surface of the detections in `models`, each surface sample

@@ -83,6 +83,7 @@ void RecognizerOptions::Check() const {
   require(preselect.models >= 0, "preselect.models", ">= 0 (0: search every model)");
   require(preselect.rows >= 3, "preselect.rows", "at least 3");
   require(preselect.checks >= 0, "preselect.checks", "0 (match.checks) or more");
+  require(preselect.shape_models >= 0, "preselect.shape_models", ">= 0 (0: none)");
   require(tracking.min_follow_score >= 0.0 && tracking.min_follow_score <= 1.0, "tracking.min_follow_score",
           "in [0, 1]");
   require(tracking.confirm_every >= 0, "tracking.confirm_every", ">= 0 (0: never)");

@@ -122,6 +122,11 @@ void AddSearchSettings(std::vector<Setting>* table) {
       "about what one of N does beyond that ranking (0: search every model)",
       [](auto& s) -> auto& { return s.options.preselect.models; }));
   table->push_back(Count(
+      "preselect-shape", 0, kNoMax,
+      "With --preselect: also search by point pairs alone the N models left out whose shape, voted with\n"
+      "a coarse point pair table, best fits the surface no detection explains (0: none)",
+      [](auto& s) -> auto& { return s.options.preselect.shape_models; }));
+  table->push_back(Count(
       "ranking-checks", 0, kNoMax,
       "Descriptors compared per query when ranking the library's views (0: as many as matching, 128);\n"
       "32 ranks in half the time, less well",

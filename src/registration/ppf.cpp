@@ -283,6 +283,7 @@ void PpfOptions::Check() const {
   require(scene_keep_normal_deg > 0.0 && scene_keep_normal_deg <= 180.0, "scene_keep_normal_deg", "in (0, 180]");
   require(reference_spacing > 0.0 && reference_spacing <= 1.0, "reference_spacing",
           "a share of the diameter in (0, 1]");
+  require(max_references >= 0, "max_references", ">= 0 (0: all)");
   require(poses_per_reference >= 1, "poses_per_reference", "at least 1");
   require(cluster_distance > 0.0, "cluster_distance", "> 0");
   require(spread_margin >= 0.0 && spread_margin <= 0.5, "spread_margin", "a share of a bin in [0, 0.5]");
@@ -528,8 +529,14 @@ std::vector<PpfPose> FindPpfPoses(const PpfModel& model, const std::vector<Orien
   std::vector<OrientedPoint> scene = sampled(scene_points);
   // The reference points: the open ones thinned to one per coarse voxel and differing normal, so that every surface
   // leads votes however few points it has.
-  const std::vector<OrientedPoint> leaders =
+  std::vector<OrientedPoint> leaders =
       SubsampleByNormals(scene, options.reference_spacing * diameter, options.scene_keep_normal_deg);
+  const auto max_references = static_cast<size_t>(options.max_references);
+  if (max_references > 0 && leaders.size() > max_references) {
+    std::vector<OrientedPoint> drawn(max_references);
+    for (size_t i = 0; i < max_references; ++i) drawn[i] = leaders[i * leaders.size() / max_references];
+    leaders = std::move(drawn);
+  }
   if (!explained.empty()) {
     const std::vector<OrientedPoint> others = sampled(explained);
     scene.insert(scene.end(), others.begin(), others.end());

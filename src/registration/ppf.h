@@ -31,6 +31,8 @@ struct PpfOptions {
   /// Reference points: the sub-sampled scene thinned again to one point per voxel of this (share of the diameter)
   /// and differing normal (scene_keep_normal_deg), an even cover of every surface.
   double reference_spacing = 0.3;
+  /// At most this many of those reference points vote, evenly drawn (0: all): a quick vote, to rank models by.
+  int max_references = 0;
   bool spread_votes = true;         ///< also look up the neighbouring bin of each feature value near a bin border
   double spread_margin = 0.15;      ///< ... "near": within this share of a bin from the border (0.5: always)
   int poses_per_reference = 3;      ///< the best poses of each reference point kept for clustering

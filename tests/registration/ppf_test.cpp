@@ -118,6 +118,25 @@ TEST(Ppf, ExplainedPointsLeadNoVote) {
   EXPECT_LT(BoxAngle(table_explained[0].camera_from_object, kBoxPose), 10.0 * kDegree);
 }
 
+// A quick vote: at most max_references reference points, and the box still the best cluster.
+TEST(Ppf, AFewReferencesStillFindTheBox) {
+  const TriangleMesh box = Box();
+  PpfOptions quick;
+  quick.max_references = 20;
+  const PpfModel model(SampleMeshSurface(box, 20000), box.Diameter(), quick);
+  const BoxOnTable scene = MakeBoxOnTable(box, kBoxPose);
+  PpfSearchStats all_stats, quick_stats;
+  FindPpfPoses(PpfModel(SampleMeshSurface(box, 20000), box.Diameter()), scene.box, {}, &all_stats);
+  const std::vector<PpfPose> poses = FindPpfPoses(model, scene.box, {}, &quick_stats);
+  ASSERT_GT(all_stats.references, 20U);
+  EXPECT_EQ(quick_stats.references, 20U);
+  ASSERT_FALSE(poses.empty());
+  EXPECT_LT(TranslationDistance(poses[0].camera_from_object, kBoxPose), 0.01);
+  EXPECT_LT(BoxAngle(poses[0].camera_from_object, kBoxPose), 10.0 * kDegree);
+  quick.max_references = -1;
+  EXPECT_THROW(quick.Check(), InputError);
+}
+
 // The banana of video 0002, plain yellow and curved, is the best cluster of the whole real frame, within 1 cm and
 // 10 degrees (it is what the context descriptors miss).
 TEST(Ppf, FindsTheBananaOfARealFrame) {
