@@ -30,10 +30,10 @@ struct PreselectOptions {
   int models = 16;
   int rows = 100;   ///< descriptors of each view ranked (a seeded random subset, as the search's ranking takes)
   int checks = 32;  ///< descriptors compared per query (0: MatchOptions::checks)
-  /// Models left out by the ranking that are searched by point pairs alone when their shape fits the surface no
-  /// detection explains (voted with a coarse table of their stored points, most votes first): plain and thin objects,
-  /// whose views rank low, are found by shape (0: none).
-  int shape_models = 0;
+  /// Models left out by the ranking that are also searched, by point pairs alone: those whose shape best fits the
+  /// surface no detection explains (a coarse table of their stored points voted there, most votes per table point
+  /// first). Plain and thin objects, whose views rank low, are found by their shape (0: none).
+  int shape_models = 4;
 };
 
 /// Tracking between the frames of a stream (Recognizer::Recognize with priors).

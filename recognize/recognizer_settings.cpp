@@ -123,8 +123,8 @@ void AddSearchSettings(std::vector<Setting>* table) {
       [](auto& s) -> auto& { return s.options.preselect.models; }));
   table->push_back(Count(
       "preselect-shape", 0, kNoMax,
-      "With --preselect: also search by point pairs alone the N models left out whose shape, voted with\n"
-      "a coarse point pair table, best fits the surface no detection explains (0: none)",
+      "With --preselect: also search by point pairs alone the N models left out whose shape best fits\n"
+      "the surface no detection explains (a coarse point pair table of each voted there; 0: none)",
       [](auto& s) -> auto& { return s.options.preselect.shape_models; }));
   table->push_back(Count(
       "ranking-checks", 0, kNoMax,

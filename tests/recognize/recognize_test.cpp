@@ -211,6 +211,7 @@ TEST_F(RecognizeEndToEnd, PreselectionSearchesOnlyTheBestScoringModels) {
   const std::vector<EvalModel> models = EvalModels(library);
   RecognizerOptions options;
   options.preselect.models = 2;
+  options.preselect.shape_models = 0;  // the ranking alone (shape candidates: YcbvLibrary)
   Recognizer preselecting(library, options);
   const RecognitionResult kept = preselecting.Recognize(frame.rgbd);
   EXPECT_EQ(kept.views_tried.size(), 2U);
